@@ -1,0 +1,35 @@
+# make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html
+# make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
+# make report      redraw every report from the stored runs, running nothing
+# SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
+
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+SCALE ?= quick
+JOBS ?= 2
+EXPERIMENTS := $(sort $(basename $(notdir $(wildcard conf/experiment/*.yaml))))
+
+.PHONY: setup test test-all replicate report benchmark
+
+setup: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+test: setup
+	$(BIN)/python -m pytest -m "not slow"
+
+test-all: setup
+	$(BIN)/python -m pytest
+
+replicate: setup
+	@for experiment in $(EXPERIMENTS); do \
+		$(BIN)/python -m replication experiment=$$experiment scale=$(SCALE) n_jobs=$(JOBS) || exit 1; \
+	done
+
+report: setup
+	$(BIN)/python -m replication.report scale=$(SCALE)

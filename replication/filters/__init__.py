@@ -1,0 +1,17 @@
+"""Filter variants.  Each is a small builder that returns an object with
+``run(model, observations, rng) -> FilterOutput``; particle filters are the one
+loop of :mod:`replication.smc.loop` with their own proposal or move.
+
+A method in an experiment config names its builder with ``filter:`` and passes
+the rest of its keys to it.
+"""
+
+from replication.filters.bootstrap import bootstrap
+from replication.filters.point_mass import PointMassFilter
+
+FILTERS = {
+    "bootstrap": bootstrap,
+    "point_mass": PointMassFilter,
+}
+
+__all__ = ["FILTERS", "PointMassFilter", "bootstrap"]

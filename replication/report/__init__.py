@@ -1,0 +1,1 @@
+"""Aggregation, tables, figures and HTML pages; reads only the result store."""

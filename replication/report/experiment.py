@@ -1,0 +1,98 @@
+"""One experiment's report: its tables as CSV and HTML, its figures, and a page tying them together."""
+
+import json
+import platform
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from omegaconf import DictConfig, OmegaConf
+
+import replication
+from replication.paths import resolve
+from replication.report.figures import FIGURES
+from replication.report.published import cells, load_published
+from replication.report.render import html_table, render
+from replication.report.tables import build_table, format_table
+from replication.report.verdict import RULES
+from replication.runner.config import Run
+from replication.runner.store import Store
+
+
+def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> Path:
+    """Write ``<reports>/<experiment>/`` from the stored records of ``runs``; return the page's path."""
+    experiment = OmegaConf.to_container(cfg.experiment, resolve=True)
+    out = resolve(cfg.reports) / experiment["name"]
+    out.mkdir(parents=True, exist_ok=True)
+    records = store.load(runs)
+    published = load_published(str(resolve(cfg.published_values)))
+    spec = experiment.get("report", {})
+    tables, figures, matched, verdicts = [], [], set(), Counter()
+    if len(records):
+        for table_spec in spec.get("tables", []):
+            table, hits = build_table(records, table_spec, experiment, published)
+            matched |= hits
+            verdicts.update(v.split(" (")[0] for v in table["verdict"])
+            csv = f"{table_spec['name']}.csv"
+            table.to_csv(out / csv, index=False)
+            html = html_table(format_table(table))
+            (out / f"{table_spec['name']}.html").write_text(html)
+            tables.append({"title": table_spec["title"], "html": html, "csv": csv})
+        for figure_spec in spec.get("figures", []):
+            file = f"{figure_spec['name']}.png"
+            FIGURES[figure_spec["kind"]](records, figure_spec, experiment["methods"], out / file)
+            figures.append({"title": figure_spec["title"], "file": file})
+        records.to_csv(out / "runs.csv", index=False)
+    paper_tables = {str(t["paper_table"]) for t in spec.get("tables", [])}
+    unmatched = pd.concat(
+        [cells(published, experiment["paper"], t) for t in sorted(paper_tables)] or [pd.DataFrame()]
+    )
+    unmatched = unmatched.drop(index=list(matched), errors="ignore")
+    page = out / "index.html"
+    page.write_text(
+        render(
+            "experiment.html.j2",
+            title=experiment.get("title", experiment["name"]),
+            paper=experiment["paper"],
+            scale=cfg.scale,
+            n_records=len(records),
+            n_runs=len(runs),
+            tables=tables,
+            figures=figures,
+            unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
+            if len(unmatched)
+            else None,
+            rules=RULES,
+            command=f"python -m replication experiment={experiment['name']} scale={cfg.scale}",
+            config=OmegaConf.to_yaml(cfg.experiment),
+            versions=_versions(),
+        )
+    )
+    summary = {
+        "name": experiment["name"],
+        "title": experiment.get("title", experiment["name"]),
+        "paper": experiment["paper"],
+        "scale": cfg.scale,
+        "n_records": len(records),
+        "n_runs": len(runs),
+        "verdicts": dict(verdicts),
+    }
+    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    return page
+
+
+def _versions() -> str:
+    import hydra
+    import joblib
+    import scipy
+
+    return "\n".join(
+        [
+            f"replication {replication.__version__}",
+            f"python {platform.python_version()} ({sys.platform})",
+            f"numpy {np.__version__}, scipy {scipy.__version__}, pandas {pd.__version__}",
+            f"hydra-core {hydra.__version__}, joblib {joblib.__version__}",
+        ]
+    )

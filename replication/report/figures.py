@@ -1,0 +1,44 @@
+"""Figures drawn from run records with matplotlib (Agg backend, PNG files)."""
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from replication.report.aggregate import summarise  # noqa: E402
+
+
+def parse_condition(condition: str) -> dict[str, str]:
+    return dict(part.split("=", 1) for part in condition.split(";") if part)
+
+
+def metric_vs_condition(records: pd.DataFrame, spec: dict, methods: dict, path: Path) -> Path:
+    """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series."""
+    summary = summarise(records, spec["metric"])
+    conditions = summary["condition"].map(parse_condition)
+    summary["x"] = conditions.map(lambda c: float(c[spec["x"]]))
+    summary["series"] = [
+        " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k != spec["x"]])
+        for m, c in zip(summary["method"], conditions)
+    ]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for series, group in summary.groupby("series", sort=False):
+        group = group.sort_values("x")
+        ax.plot(group["x"], group["mean"], marker="o", label=series)
+        ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
+    ax.set_xscale("log")
+    ax.set_xlabel(spec["x"])
+    ax.set_ylabel(f"{spec['metric']} (mean, 95% CI)")
+    ax.set_title(spec.get("title", ""))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+FIGURES = {"metric_vs_condition": metric_vs_condition}

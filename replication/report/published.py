@@ -1,0 +1,35 @@
+"""The published numbers, one row per table cell (``../shared/reference/published_values.csv``)."""
+
+import warnings
+from functools import lru_cache
+from pathlib import Path
+
+import pandas as pd
+
+COLUMNS = ["paper", "table", "experiment", "method", "metric", "condition", "value", "unit", "note"]
+
+
+@lru_cache(maxsize=4)
+def load_published(path: str) -> pd.DataFrame:
+    """All published cells as strings except ``value`` (numeric where it is a number).
+
+    A missing file gives an empty table and a warning: the report then shows
+    our numbers without the paper's.
+    """
+    if not Path(path).exists():
+        warnings.warn(f"published values not found at {path}; tables will have no paper column", stacklevel=2)
+        return pd.DataFrame(columns=COLUMNS + ["number"])
+    table = pd.read_csv(path, dtype=str, keep_default_na=False)
+    missing = set(COLUMNS) - set(table.columns)
+    if missing:
+        raise ValueError(f"{path} lacks columns {sorted(missing)}")
+    table["number"] = pd.to_numeric(table["value"], errors="coerce")
+    return table
+
+
+def cells(published: pd.DataFrame, paper: str, table: str, metric: str | None = None) -> pd.DataFrame:
+    """The published cells of one paper table (and one metric, if given)."""
+    chosen = (published["paper"] == paper) & (published["table"] == str(table))
+    if metric is not None:
+        chosen &= published["metric"] == metric
+    return published[chosen]

@@ -1,0 +1,84 @@
+"""Paper tables rebuilt from run records: ours (mean, 95% interval) | paper | verdict."""
+
+import numpy as np
+import pandas as pd
+
+from replication.report.aggregate import mean_interval, summarise
+from replication.report.published import cells
+from replication.report.verdict import verdict
+
+FLOOR_FILTER = "point_mass"
+
+
+def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
+    """Return (table, index labels of the published cells it matched) for one ``report.tables`` entry."""
+    metric, paper_metric = spec["metric"], spec.get("paper_metric", spec["metric"])
+    ours = summarise(records, metric)
+    ours = ours[ours["runs"] > 0].reset_index(drop=True)
+    theirs = cells(published, experiment["paper"], spec["paper_table"], paper_metric).copy()
+    theirs["condition"] = theirs["condition"].replace("", spec.get("paper_condition", ""))
+    methods = experiment["methods"]
+    floor_low, excess = None, {}
+    if metric == "rmse":
+        floors = ours[[methods[m]["filter"] == FLOOR_FILTER for m in ours["method"]]]
+        floor_low = floors["ci_low"].min() if len(floors) else None
+        excess = excess_over_floor(records, [m for m in methods if methods[m]["filter"] == FLOOR_FILTER])
+    rows, matched = [], set()
+    for _, row in ours.iterrows():
+        hit = theirs[(theirs["method"] == row["method"]) & (theirs["condition"] == row["condition"])]
+        paper = float(hit["number"].iloc[0]) if len(hit) else np.nan
+        matched.update(hit.index)
+        entry = {
+            "method": methods[row["method"]].get("label", row["method"]),
+            "condition": row["condition"] or "-",
+            "runs": row["runs"],
+            "ours": row["mean"],
+            "ci_low": row["ci_low"],
+            "ci_high": row["ci_high"],
+        }
+        if excess:
+            entry["excess_over_floor"], entry["excess_ci_low"], entry["excess_ci_high"] = excess.get(
+                (row["method"], row["condition"]), (np.nan, np.nan, np.nan)
+            )
+        if spec.get("show_variance"):
+            entry["variance"] = row["variance"]
+        entry["paper"] = paper
+        entry["verdict"] = verdict(paper, row["mean"], row["ci_low"], row["ci_high"], paper_metric, floor_low)
+        rows.append(entry)
+    return pd.DataFrame(rows), matched
+
+
+def excess_over_floor(records: pd.DataFrame, floor_methods: list[str]) -> dict:
+    """Paired RMSE minus the point-mass filter's RMSE on the same trajectory: mean and 95% interval.
+
+    Every method filters the same data at a given repetition, so the paired
+    difference isolates the filter's own error from the run-to-run spread.
+    """
+    floor = records[records["method"].isin(floor_methods)][["data_condition", "repetition", "rmse"]]
+    if floor.empty:
+        return {}
+    paired = records.merge(floor, on=["data_condition", "repetition"], suffixes=("", "_floor"))
+    paired = paired[~paired["method"].isin(floor_methods)]
+    return {
+        key: mean_interval(group["rmse"] - group["rmse_floor"])
+        for key, group in paired.groupby(["method", "condition"], sort=False)
+    }
+
+
+def format_table(table: pd.DataFrame) -> pd.DataFrame:
+    """Numbers as text for HTML: 'mean [low, high]' and the paper's value as printed."""
+    shown = pd.DataFrame({"method": table["method"], "condition": table["condition"], "runs": table["runs"]})
+    shown["ours (95% CI)"] = [
+        f"{m:.4g} [{lo:.4g}, {hi:.4g}]" if np.isfinite(lo) else f"{m:.4g}"
+        for m, lo, hi in zip(table["ours"], table["ci_low"], table["ci_high"])
+    ]
+    if "excess_over_floor" in table:
+        shown["excess over the floor (paired, 95% CI)"] = [
+            "" if not np.isfinite(m) else f"{m:+.3g} [{lo:+.3g}, {hi:+.3g}]"
+            for m, lo, hi in zip(table["excess_over_floor"], table["excess_ci_low"], table["excess_ci_high"])
+        ]
+    if "variance" in table:
+        shown["variance over runs"] = table["variance"].map(lambda v: f"{v:.4g}")
+    shown["paper"] = table["paper"].map(lambda v: "" if np.isnan(v) else f"{v:g}")
+    shown["verdict"] = table["verdict"]
+    return shown

@@ -1,0 +1,1 @@
+"""Experiment runner: config -> runs -> parallel execution -> result store."""

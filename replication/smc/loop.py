@@ -1,0 +1,162 @@
+"""The one particle-filter loop: propose -> move -> weight -> estimate -> resample.
+
+Variants plug in as small strategy objects instead of copying the loop:
+
+* a :class:`Proposal` replaces the prior ``x_t ~ p(x_t | x_{t-1})`` (for example a
+  quasi-Monte-Carlo mixture proposal) and returns the log-weights it implies;
+* a :class:`Move` shifts the proposed particles (PSO, harmony search, mean shift)
+  and returns the log-weight correction for the shift (zero where a paper
+  ignores it).
+
+The bootstrap filter of Gordon, Salmond and Smith (1993) is the loop with
+neither.
+"""
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from replication.smc.resampling import RESAMPLERS
+from replication.smc.weights import (
+    DegenerateWeightsError,
+    ess,
+    normalise,
+    weighted_mean,
+    weighted_variance,
+)
+
+LogLikelihood = Callable[[np.ndarray], np.ndarray]
+
+
+class StateSpaceModel(Protocol):
+    """What the loop needs of a model; observations may be numbers or images."""
+
+    def sample_initial(self, n: int, rng: np.random.Generator) -> np.ndarray: ...
+
+    def propagate(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray: ...
+
+    def log_likelihood(self, particles: np.ndarray, observation, t: int) -> np.ndarray: ...
+
+
+class Proposal(Protocol):
+    """Draw x_t given the weighted particles at t-1; return (particles, log_weights before the likelihood)."""
+
+    def __call__(
+        self,
+        model: StateSpaceModel,
+        particles: np.ndarray,
+        log_weights: np.ndarray,
+        t: int,
+        rng: np.random.Generator,
+    ) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+class Move(Protocol):
+    """Move proposed particles towards high likelihood; return (particles, log-weight correction)."""
+
+    def __call__(
+        self, particles: np.ndarray, log_likelihood: LogLikelihood, rng: np.random.Generator
+    ) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+def prior_proposal(model, particles, log_weights, t, rng):
+    """The bootstrap proposal: x_t^i ~ p(x_t | x_{t-1}^i), weights carried over unchanged."""
+    return model.propagate(particles, t, rng), log_weights
+
+
+@dataclass(frozen=True)
+class ResamplingPolicy:
+    """Resample with ``scheme`` whenever ``ESS < ess_threshold * N``; a threshold of 1 means every step."""
+
+    scheme: str = "systematic"
+    ess_threshold: float = 0.5
+
+    def __post_init__(self):
+        if self.scheme not in RESAMPLERS:
+            raise ValueError(f"unknown resampling scheme {self.scheme!r}; choose one of {sorted(RESAMPLERS)}")
+        if not 0.0 <= self.ess_threshold <= 1.0:
+            raise ValueError(f"ess_threshold must lie in [0, 1], got {self.ess_threshold}")
+
+    def wants(self, ess_value: float, n: int) -> bool:
+        return self.ess_threshold >= 1.0 or ess_value < self.ess_threshold * n
+
+
+@dataclass
+class FilterOutput:
+    """Per-step summaries of one filter run (index 0 is the first observation)."""
+
+    means: np.ndarray
+    variances: np.ndarray
+    ess: np.ndarray
+    resampled: np.ndarray
+    degenerate: np.ndarray
+    log_evidence: float
+
+    @property
+    def resample_count(self) -> int:
+        return int(self.resampled.sum())
+
+
+@dataclass
+class ParticleFilter:
+    """A particle filter with N particles, a proposal, an optional move and a resampling policy."""
+
+    n_particles: int
+    resampling: ResamplingPolicy = field(default_factory=ResamplingPolicy)
+    proposal: Proposal = prior_proposal
+    move: Move | None = None
+
+    def __post_init__(self):
+        if int(self.n_particles) != self.n_particles or self.n_particles <= 0:
+            raise ValueError(f"n_particles must be a positive integer, got {self.n_particles}")
+        self.n_particles = int(self.n_particles)
+
+    def run(self, model: StateSpaceModel, observations, rng: np.random.Generator) -> FilterOutput:
+        """Filter ``observations`` (z_1 .. z_T) and return the per-step estimates.
+
+        A step where every log-weight is -inf (no particle explains z_t) is
+        recovered by keeping the predicted weights (those before the
+        likelihood), as if z_t had carried no information; it is flagged in
+        ``FilterOutput.degenerate`` (log_evidence then gets the predicted mass only).
+        """
+        n = self.n_particles
+        particles = model.sample_initial(n, rng)
+        log_weights = np.full(n, -np.log(n))
+        means, variances, ess_values, resampled, degenerate = [], [], [], [], []
+        log_evidence = 0.0
+        for t, z in enumerate(observations, start=1):
+            particles, log_weights = self.proposal(model, particles, log_weights, t, rng)
+            if self.move is not None:
+                particles, correction = self.move(
+                    particles, lambda x, z=z, t=t: model.log_likelihood(x, z, t), rng
+                )
+                log_weights = log_weights + correction
+            predicted = log_weights
+            log_weights = log_weights + model.log_likelihood(particles, z, t)
+            try:
+                weights, log_total = normalise(log_weights)
+                degenerate.append(False)
+            except DegenerateWeightsError:
+                log_weights = predicted
+                weights, log_total = normalise(predicted)
+                degenerate.append(True)
+            log_evidence += log_total
+            log_weights = log_weights - log_total
+            means.append(weighted_mean(particles, weights))
+            variances.append(weighted_variance(particles, weights))
+            ess_values.append(ess(weights))
+            do_resample = self.resampling.wants(ess_values[-1], n)
+            if do_resample:
+                particles = particles[RESAMPLERS[self.resampling.scheme](weights, rng)]
+                log_weights = np.full(n, -np.log(n))
+            resampled.append(do_resample)
+        return FilterOutput(
+            means=np.asarray(means),
+            variances=np.asarray(variances),
+            ess=np.asarray(ess_values),
+            resampled=np.asarray(resampled, dtype=bool),
+            degenerate=np.asarray(degenerate, dtype=bool),
+            log_evidence=log_evidence,
+        )

@@ -1,0 +1,45 @@
+"""Importance weights kept as log-weights, and the estimators built on them."""
+
+import numpy as np
+from scipy.special import logsumexp
+
+
+class DegenerateWeightsError(ValueError):
+    """Every log-weight is -inf: the weights cannot be normalised."""
+
+
+def normalise(log_weights: np.ndarray) -> tuple[np.ndarray, float]:
+    """Return normalised weights ``W_i = exp(lw_i - logsumexp(lw))`` and ``logsumexp(lw)``.
+
+    Works in the log domain throughout, so weights that would all underflow
+    as raw products of likelihoods are still normalised correctly.  Raises
+    :class:`DegenerateWeightsError` when every log-weight is -inf and
+    ``ValueError`` on NaN or +inf (a bug in the model, never data).
+    """
+    log_weights = np.asarray(log_weights, dtype=float)
+    if np.isnan(log_weights).any() or np.isposinf(log_weights).any():
+        raise ValueError("log-weights contain NaN or +inf")
+    log_total = logsumexp(log_weights)
+    if not np.isfinite(log_total):
+        raise DegenerateWeightsError("every log-weight is -inf")
+    return np.exp(log_weights - log_total), float(log_total)
+
+
+def ess(weights: np.ndarray) -> float:
+    """Effective sample size ``1 / sum W_i^2`` of normalised weights (Kong, Liu and Wong, 1994).
+
+    Lies in [1, N]: N for uniform weights, 1 when one weight carries all the mass.
+    """
+    weights = np.asarray(weights, dtype=float)
+    return float(1.0 / np.dot(weights, weights))
+
+
+def weighted_mean(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """The self-normalised importance-sampling estimate ``sum W_i x_i`` (over the first axis)."""
+    return np.tensordot(weights, particles, axes=(0, 0))
+
+
+def weighted_variance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Per-coordinate weighted variance ``sum W_i (x_i - mean)^2``."""
+    centred = particles - weighted_mean(particles, weights)
+    return np.tensordot(weights, centred**2, axes=(0, 0))

@@ -1,0 +1,78 @@
+"""Models against their equations, and the point-mass filter against exact posteriors."""
+
+import numpy as np
+import pytest
+
+from replication.filters import PointMassFilter
+from replication.models import UNGM, LinearGaussian, kalman_filter, point_mass_filter
+
+
+def test_ungm_transition_and_observation_hand_computed():
+    model = UNGM()
+    # t = 1: 0.5*2 + 25*2/5 + 8cos(0) = 1 + 10 + 8
+    assert model.f(np.array([2.0]), 1)[0] == pytest.approx(19.0)
+    assert model.f(np.array([0.0]), 2)[0] == pytest.approx(8 * np.cos(1.2))
+    assert model.h(np.array([10.0]))[0] == pytest.approx(5.0)
+    # log N(z; x^2/20, R=1) at z = h(x): the peak of a unit-variance Gaussian
+    assert model.log_likelihood(np.array([10.0]), 5.0, 1)[0] == pytest.approx(-0.5 * np.log(2 * np.pi))
+
+
+def test_simulation_is_reproducible_and_has_model_noise():
+    model = UNGM(steps=2000)
+    states, observations = model.simulate(np.random.default_rng(3))
+    again = model.simulate(np.random.default_rng(3))
+    np.testing.assert_array_equal(states, again[0])
+    residuals = observations - model.h(states)
+    assert residuals.var() == pytest.approx(model.R, rel=0.1)
+    process = states[1:] - model.f(states[:-1], np.arange(2, 2001))
+    assert process.var() == pytest.approx(model.Q, rel=0.1)
+
+
+def test_known_initial_state():
+    model = UNGM(x0=1.0, P0=0.0)
+    assert np.all(model.sample_initial(5, np.random.default_rng(0)) == 1.0)
+
+
+@pytest.mark.parametrize("P0", [0.0, 1.0, 5.0])
+def test_point_mass_filter_equals_kalman_on_linear_gaussian(P0):
+    model = LinearGaussian(a=0.95, c=0.8, Q=2.0, R=0.3, x0=1.0, P0=P0, steps=40)
+    observations = model.simulate(np.random.default_rng(1))[1]
+    kalman_means, kalman_variances = kalman_filter(model, observations)
+    means, variances = point_mass_filter(model, observations, n_points=1601, half_width=60.0)
+    np.testing.assert_allclose(means, kalman_means, atol=1e-8)
+    np.testing.assert_allclose(variances, kalman_variances, atol=1e-8)
+
+
+def test_point_mass_filter_is_converged_on_ungm():
+    """The UNGM grid (spacing 0.1 on [-80, 80]) agrees with one of half the spacing to 1e-6."""
+    model = UNGM(steps=60)
+    for seed in range(3):
+        observations = model.simulate(np.random.default_rng(seed))[1]
+        coarse, _ = point_mass_filter(model, observations, n_points=1601, half_width=80.0)
+        fine, _ = point_mass_filter(model, observations, n_points=3201, half_width=80.0)
+        wide, _ = point_mass_filter(model, observations, n_points=2001, half_width=100.0)
+        np.testing.assert_allclose(coarse, fine, atol=1e-6)
+        np.testing.assert_allclose(coarse, wide, atol=1e-6)
+
+
+def test_point_mass_mean_is_the_best_estimator_on_average():
+    """Across trajectories the grid posterior mean has lower MSE than a large particle filter's."""
+    from replication.filters import bootstrap
+
+    model = UNGM(steps=50)
+    grid_se, pf_se = [], []
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        states, observations = model.simulate(rng)
+        grid_se.append(np.mean((PointMassFilter().run(model, observations).means - states) ** 2))
+        pf_se.append(np.mean((bootstrap(100).run(model, observations, rng).means - states) ** 2))
+    assert np.mean(grid_se) <= np.mean(pf_se)
+
+
+def test_model_parameters_are_checked():
+    with pytest.raises(ValueError, match="variances"):
+        UNGM(Q=0.0)
+    with pytest.raises(ValueError, match="steps"):
+        UNGM(steps=0)
+    with pytest.raises(ValueError, match="P0"):
+        UNGM(P0=-1.0)
