@@ -30,7 +30,7 @@ class Store:
     def write(self, run: Run, record: dict) -> None:
         """Write ``record`` so that a crash leaves either the whole file or none of it."""
         self.directory.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=".tmp-", suffix=".json")
+        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=".", suffix=".tmp")
         try:
             with os.fdopen(fd, "w") as handle:
                 json.dump(record, handle, indent=1, sort_keys=True)

@@ -1,0 +1,50 @@
+import sys
+from pathlib import Path
+
+import pytest
+from hydra import compose, initialize_config_dir
+
+from replication.paths import CONF_DIR, PROJECT_ROOT
+
+
+@pytest.fixture
+def make_cfg(tmp_path):
+    """Compose a config the way the CLI does, with the store and reports in a temporary folder."""
+
+    def make(experiment="gps_qmcpf_ungm", *overrides):
+        with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+            return compose(
+                "config",
+                overrides=[
+                    f"experiment={experiment}",
+                    f"store={tmp_path / 'experiments'}",
+                    f"reports={tmp_path / 'reports'}",
+                    "progress=false",
+                    *overrides,
+                ],
+            )
+
+    return make
+
+
+@pytest.fixture
+def cli(tmp_path):
+    """The command line as a user runs it, with its store and reports in a temporary folder."""
+    import subprocess
+
+    def run(*args, timeout=300):
+        command = [
+            sys.executable,
+            "-m",
+            "replication",
+            *args,
+            f"store={tmp_path / 'experiments'}",
+            f"reports={tmp_path / 'reports'}",
+            "progress=false",
+        ]
+        return subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=timeout)
+
+    return run
+
+
+SMALL = ("scale=quick", "experiment.runs.quick=3")

@@ -1,0 +1,169 @@
+"""The runner: validation before work, identity-keyed seeds, determinism, atomic store and resume."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+from conftest import SMALL
+
+from replication.paths import PROJECT_ROOT
+from replication.runner.config import ConfigError, expand
+from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.seeding import seed_sequence
+from replication.runner.store import Store
+
+
+def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    """Everything in a record except wall-clock timings, sorted by run."""
+    return frame.drop(columns=list(TIMING_COLUMNS)).sort_values("run_id").reset_index(drop=True)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("experiment=no_such_paper",), "unknown experiment 'no_such_paper'"),
+        ((), "name an experiment"),
+        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.filter=magic"), "unknown filter 'magic'"),
+        (("experiment=gps_qmcpf_ungm", "+experiment.methods.XPF.n_particles=10"), "method 'XPF': no 'filter:' key"),
+        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.n_particles=0"), "n_particles must be a positive"),
+        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.n_particles=[100,-5]"), "at N=-5"),
+        (("experiment=gps_qmcpf_ungm", "scale=huge"), "scale must be one of"),
+        (("experiment=gps_qmcpf_ungm", "experiment.model.name=lorenz"), "unknown model 'lorenz'"),
+        (("experiment=gps_qmcpf_ungm", "experiment.model.Q=-1"), "noise variances must be positive"),
+        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.resampling.scheme=bogus"), "unknown resampling"),
+    ],
+)
+def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):
+    result = cli(*args, timeout=60)
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert not (tmp_path / "experiments").exists()  # no work started
+
+
+def test_expansion_is_method_by_condition_by_repetition(make_cfg):
+    runs = expand(make_cfg("gps_qmcpf_ungm", *SMALL))
+    assert len(runs) == (3 + 1) * 3  # PF at N = 500, 200, 100 and the grid, 3 repetitions each
+    assert {(r.method, r.condition) for r in runs} == {("PF", "N=500"), ("PF", "N=200"), ("PF", "N=100"), ("grid", "")}
+    assert len({r.run_id for r in runs}) == len(runs)
+    paper = expand(make_cfg("gps_qmcpf_ungm"))
+    assert len(paper) == 4 * 100
+
+
+def test_model_sweeps_share_data_per_condition(make_cfg):
+    runs = expand(make_cfg("ungm_horizon", *SMALL))
+    first = {r.method + r.condition: r for r in runs if r.repetition == 0}
+    a, b = first["PFT=50;N=100"], first["gridT=50"]
+    assert a.data_condition == b.data_condition == "T=50"
+    assert a.rng("data").random() == b.rng("data").random()  # common random numbers for the data
+    assert a.rng("filter").random() != b.rng("filter").random()
+    assert first["PFT=10;N=100"].rng("data").random() != a.rng("data").random()
+
+
+def test_seed_is_a_function_of_identity_only():
+    a = seed_sequence(7, "filter", "PF", "N=500", 3)
+    b = seed_sequence(7, "filter", "PF", "N=500", 3)
+    assert a.generate_state(4).tolist() == b.generate_state(4).tolist()
+    assert seed_sequence(7, "filter", "PF", "N=500", 4).generate_state(4).tolist() != a.generate_state(4).tolist()
+    assert seed_sequence(8, "filter", "PF", "N=500", 3).generate_state(4).tolist() != a.generate_state(4).tolist()
+    # the same as walking SeedSequence.spawn: a child's spawn key extends its parent's
+    assert a.spawn(1)[0].spawn_key == a.spawn_key + (0,)
+
+
+def test_one_job_and_two_jobs_and_any_order_give_identical_records(make_cfg, tmp_path):
+    cfg = make_cfg("gps_qmcpf_ungm", *SMALL)
+    runs = expand(cfg)
+    frames = []
+    for label, n_jobs, order in [("one", 1, runs), ("two", 2, runs), ("shuffled", 2, runs[::-1])]:
+        store = Store(tmp_path / label, cfg.experiment.name)
+        assert execute(order, store, n_jobs=n_jobs, progress=False) == len(runs)
+        frames.append(deterministic_columns(store.load(runs)))
+    assert len(frames[0]) == len(runs)
+    pd.testing.assert_frame_equal(frames[0], frames[1])
+    pd.testing.assert_frame_equal(frames[0], frames[2])
+
+
+def test_rerun_skips_stored_runs_and_more_repetitions_reuse_them(make_cfg, tmp_path):
+    cfg = make_cfg("hspf_ungm", *SMALL)
+    runs = expand(cfg)
+    store = Store(tmp_path / "store", cfg.experiment.name)
+    assert execute(runs, store, n_jobs=1, progress=False) == len(runs)
+    assert execute(runs, store, n_jobs=1, progress=False) == 0
+    more = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=5"))
+    assert execute(more, store, n_jobs=1, progress=False) == len(more) - len(runs)
+
+
+def test_changed_config_lands_in_new_files(make_cfg, tmp_path):
+    base = expand(make_cfg("hspf_ungm", *SMALL))
+    changed = expand(make_cfg("hspf_ungm", *SMALL, "experiment.model.Q=5"))
+    relabelled = expand(make_cfg("hspf_ungm", *SMALL, "experiment.methods.PF.label=renamed"))
+    assert {r.run_id for r in base}.isdisjoint({r.run_id for r in changed})
+    assert {r.run_id for r in base} == {r.run_id for r in relabelled}  # a label changes no number
+    store = Store(tmp_path / "store", "hspf_ungm")
+    execute(base, store, n_jobs=1, progress=False)
+    assert store.load(changed).empty
+
+
+def test_store_write_is_atomic(tmp_path, make_cfg):
+    run = expand(make_cfg("hspf_ungm", *SMALL))[0]
+    store = Store(tmp_path, "hspf_ungm")
+
+    class Unserialisable:
+        pass
+
+    with pytest.raises(TypeError):
+        store.write(run, {"x": Unserialisable()})
+    assert not store.has(run)
+    assert list(store.directory.iterdir()) == []  # no partial file, no stray temporary
+    store.write(run, {"x": 1.0})
+    assert json.loads(store.path(run).read_text()) == {"x": 1.0}
+
+
+def test_interrupted_job_resumes_to_the_same_table(tmp_path):
+    """Kill a real run part-way (SIGKILL: no clean-up), resume it, compare with an uninterrupted run."""
+    args = ["experiment=ungm_horizon", "scale=quick", "experiment.runs.quick=6", "n_jobs=2", "progress=false"]
+
+    def command(store):
+        return [sys.executable, "-m", "replication", *args, f"store={store}", f"reports={tmp_path / 'reports'}"]
+
+    reference = subprocess.run(command(tmp_path / "a"), cwd=PROJECT_ROOT, capture_output=True, text=True)
+    assert reference.returncode == 0, reference.stderr
+    runs_dir = tmp_path / "b" / "ungm_horizon" / "runs"
+    process = subprocess.Popen(command(tmp_path / "b"), cwd=PROJECT_ROOT, start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(runs_dir.glob("*.json"))) < 10:
+        time.sleep(0.02)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    partial = len(list(runs_dir.glob("*.json")))
+    total = len(list((tmp_path / "a" / "ungm_horizon" / "runs").glob("*.json")))
+    assert 10 <= partial < total, (partial, total)
+    resumed = subprocess.run(command(tmp_path / "b"), cwd=PROJECT_ROOT, capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{total - partial} runs computed, {partial} already stored" in resumed.stdout
+
+    def table(store):
+        records = [json.loads(p.read_text()) for p in (store / "ungm_horizon" / "runs").glob("*.json")]
+        return deterministic_columns(pd.DataFrame(records))
+
+    pd.testing.assert_frame_equal(table(tmp_path / "a"), table(tmp_path / "b"))
+
+
+def test_cli_end_to_end_writes_report(cli, tmp_path):
+    result = cli("experiment=gps_qmcpf_ungm", *SMALL)
+    assert result.returncode == 0, result.stderr
+    assert "12 runs computed, 0 already stored" in result.stdout
+    out = tmp_path / "reports" / "gps_qmcpf_ungm"
+    table = pd.read_csv(out / "table1_rmse.csv")
+    assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100", "-"]
+    assert np.all(table["runs"] == 3)
+    assert (tmp_path / "reports" / "index.html").exists()
+    again = cli("experiment=gps_qmcpf_ungm", *SMALL)
+    assert "0 runs computed, 12 already stored" in again.stdout
