@@ -1,6 +1,7 @@
 # make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html
 # make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
 # make report      redraw every report from the stored runs, running nothing
+# make benchmark   time the SMC core on this machine (reports/benchmark/)
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -30,6 +31,10 @@ replicate: setup
 	@for experiment in $(EXPERIMENTS); do \
 		$(BIN)/python -m replication experiment=$$experiment scale=$(SCALE) n_jobs=$(JOBS) || exit 1; \
 	done
+	$(BIN)/python -m replication.benchmark
+
+benchmark: setup
+	$(BIN)/python -m replication.benchmark
 
 report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)

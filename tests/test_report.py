@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.report.aggregate import mean_interval, summarise
+from replication.report.aggregate import comparison_interval, mean_interval, summarise
 from replication.report.published import load_published
 from replication.report.tables import build_table, format_table
 from replication.report.verdict import verdict
@@ -23,6 +23,16 @@ def test_mean_interval_hand_computed():
     assert mean - low == pytest.approx(high - mean)
     assert np.isnan(mean_interval([5.0])[1])
     assert np.isnan(mean_interval([])[0])
+
+
+def test_comparison_interval_widens_for_the_papers_own_noise():
+    # sd 2, 25 runs of ours, 100 of theirs: half-width t_{0.975,24} * 2 * sqrt(1/25 + 1/100)
+    low, high = comparison_interval(10.0, 2.0, 25, 100)
+    assert high - 10.0 == pytest.approx(2.063899 * 2.0 * np.sqrt(0.05), rel=1e-5)
+    assert 10.0 - low == pytest.approx(high - 10.0)
+    own = comparison_interval(10.0, 2.0, 25, None)
+    assert own[1] - 10.0 == pytest.approx(2.063899 * 2.0 / 5.0, rel=1e-5)  # our own 95% interval
+    assert np.isnan(comparison_interval(1.0, np.nan, 1, 100)[0])
 
 
 def test_interval_covers_the_true_mean_about_95_percent_of_the_time():

@@ -20,6 +20,21 @@ def mean_interval(values) -> tuple[float, float, float]:
     return mean, mean - half, mean + half
 
 
+def comparison_interval(mean: float, sd: float, runs: int, paper_runs: int | None) -> tuple[float, float]:
+    """The 95% interval a published mean over ``paper_runs`` runs should fall in if both estimate the same thing.
+
+    ``mean ± t · sd · sqrt(1/runs + 1/paper_runs)``: the published value is
+    itself a Monte Carlo mean, whose spread we estimate by our own ``sd``.
+    With ``paper_runs`` unknown (None) the published value is taken as exact
+    and this is our own 95% interval.
+    """
+    if runs < 2 or not np.isfinite(sd):
+        return np.nan, np.nan
+    spread = 1.0 / runs + (1.0 / paper_runs if paper_runs else 0.0)
+    half = float(stats.t.ppf(0.5 + LEVEL / 2, runs - 1) * sd * np.sqrt(spread))
+    return mean - half, mean + half
+
+
 def summarise(records: pd.DataFrame, metric: str) -> pd.DataFrame:
     """One row per (method, condition): runs, mean, 95% interval, variance and median over runs."""
     rows = []
@@ -34,6 +49,7 @@ def summarise(records: pd.DataFrame, metric: str) -> pd.DataFrame:
                 "mean": mean,
                 "ci_low": low,
                 "ci_high": high,
+                "sd": float(values.std(ddof=1)) if len(values) > 1 else np.nan,
                 "variance": float(values.var(ddof=1)) if len(values) > 1 else np.nan,
                 "median": float(values.median()),
             }

@@ -27,6 +27,7 @@ def write_index(reports: Path) -> Path:
             title="Particle-filter tracking papers: replication report",
             experiments=experiments,
             missing=missing,
+            benchmark=(reports / "benchmark" / "index.html").exists(),
             generated=datetime.date.today().isoformat(),
             version=replication.__version__,
         )

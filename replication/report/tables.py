@@ -3,7 +3,7 @@
 import numpy as np
 import pandas as pd
 
-from replication.report.aggregate import mean_interval, summarise
+from replication.report.aggregate import comparison_interval, mean_interval, summarise
 from replication.report.published import cells
 from replication.report.verdict import verdict
 
@@ -18,10 +18,14 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
     theirs = cells(published, experiment["paper"], spec["paper_table"], paper_metric).copy()
     theirs["condition"] = theirs["condition"].replace("", spec.get("paper_condition", ""))
     methods = experiment["methods"]
+    paper_runs = spec.get("paper_runs")
+    ours[["cmp_low", "cmp_high"]] = [
+        comparison_interval(m, sd, n, paper_runs) for m, sd, n in zip(ours["mean"], ours["sd"], ours["runs"])
+    ]
     floor_low, excess = None, {}
     if metric == "rmse":
         floors = ours[[methods[m]["filter"] == FLOOR_FILTER for m in ours["method"]]]
-        floor_low = floors["ci_low"].min() if len(floors) else None
+        floor_low = floors["cmp_low"].min() if len(floors) else None
         excess = excess_over_floor(records, [m for m in methods if methods[m]["filter"] == FLOOR_FILTER])
     rows, matched = [], set()
     for _, row in ours.iterrows():
@@ -43,7 +47,7 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
         if spec.get("show_variance"):
             entry["variance"] = row["variance"]
         entry["paper"] = paper
-        entry["verdict"] = verdict(paper, row["mean"], row["ci_low"], row["ci_high"], paper_metric, floor_low)
+        entry["verdict"] = verdict(paper, row["mean"], row["cmp_low"], row["cmp_high"], paper_metric, floor_low)
         rows.append(entry)
     return pd.DataFrame(rows), matched
 

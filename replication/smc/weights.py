@@ -1,7 +1,6 @@
 """Importance weights kept as log-weights, and the estimators built on them."""
 
 import numpy as np
-from scipy.special import logsumexp
 
 
 class DegenerateWeightsError(ValueError):
@@ -17,12 +16,14 @@ def normalise(log_weights: np.ndarray) -> tuple[np.ndarray, float]:
     ``ValueError`` on NaN or +inf (a bug in the model, never data).
     """
     log_weights = np.asarray(log_weights, dtype=float)
-    if np.isnan(log_weights).any() or np.isposinf(log_weights).any():
+    top = log_weights.max()
+    if np.isnan(top) or top == np.inf:
         raise ValueError("log-weights contain NaN or +inf")
-    log_total = logsumexp(log_weights)
-    if not np.isfinite(log_total):
+    if top == -np.inf:
         raise DegenerateWeightsError("every log-weight is -inf")
-    return np.exp(log_weights - log_total), float(log_total)
+    weights = np.exp(log_weights - top)
+    total = weights.sum()
+    return weights / total, float(top + np.log(total))
 
 
 def ess(weights: np.ndarray) -> float:
@@ -36,10 +37,10 @@ def ess(weights: np.ndarray) -> float:
 
 def weighted_mean(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """The self-normalised importance-sampling estimate ``sum W_i x_i`` (over the first axis)."""
-    return np.tensordot(weights, particles, axes=(0, 0))
+    return weights @ particles
 
 
 def weighted_variance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Per-coordinate weighted variance ``sum W_i (x_i - mean)^2``."""
     centred = particles - weighted_mean(particles, weights)
-    return np.tensordot(weights, centred**2, axes=(0, 0))
+    return weights @ centred**2
