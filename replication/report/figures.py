@@ -16,20 +16,30 @@ def parse_condition(condition: str) -> dict[str, str]:
 
 
 def metric_vs_condition(records: pd.DataFrame, spec: dict, methods: dict, path: Path) -> Path:
-    """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series."""
+    """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
+
+    A method that does not sweep ``x`` (the point-mass reference, say) is drawn
+    as a horizontal band.
+    """
     summary = summarise(records, spec["metric"])
     conditions = summary["condition"].map(parse_condition)
-    summary["x"] = conditions.map(lambda c: float(c[spec["x"]]))
+    summary["x"] = conditions.map(lambda c: float(c.get(spec["x"], "nan")))
     summary["series"] = [
         " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k != spec["x"]])
         for m, c in zip(summary["method"], conditions)
     ]
     fig, ax = plt.subplots(figsize=(6, 4))
-    for series, group in summary.groupby("series", sort=False):
+    swept = summary[summary["x"].notna()]
+    for series, group in swept.groupby("series", sort=False):
         group = group.sort_values("x")
         ax.plot(group["x"], group["mean"], marker="o", label=series)
         ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
+    for _, row in summary[summary["x"].isna()].iterrows():
+        line = ax.axhline(row["mean"], linestyle="--", color="k", label=row["series"])
+        ax.axhspan(row["ci_low"], row["ci_high"], color=line.get_color(), alpha=0.1)
     ax.set_xscale("log")
+    if spec.get("log_y"):
+        ax.set_yscale("log")
     ax.set_xlabel(spec["x"])
     ax.set_ylabel(f"{spec['metric']} (mean, 95% CI)")
     ax.set_title(spec.get("title", ""))
