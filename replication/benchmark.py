@@ -47,7 +47,7 @@ def measure() -> pd.DataFrame:
         for scheme, resample in RESAMPLERS.items():
             seconds = best_of(lambda: resample(weights, rng))
             rows.append({"what": f"resample ({scheme})", "N": n, "us_per_call": 1e6 * seconds})
-        pf = bootstrap(n, {"scheme": "systematic", "ess_threshold": 1.0})
+        pf = bootstrap(n, "systematic", 1.0)
         seconds = best_of(lambda: pf.run(model, observations, rng), repeats=3) / model.steps
         rows.append({"what": "bootstrap PF step (UNGM)", "N": n, "us_per_call": 1e6 * seconds})
     for points in (801, 1601, 3201):

@@ -16,7 +16,7 @@ def rms_gap_to_kalman(n, repeats=24, seed=0):
     kalman_means, _ = kalman_filter(MODEL, observations)
     seeds = np.random.SeedSequence(seed).spawn(repeats)
     gaps = [
-        bootstrap(n, {"scheme": "systematic", "ess_threshold": 0.5})
+        bootstrap(n, "systematic", 0.5)
         .run(MODEL, observations, np.random.default_rng(s))
         .means
         - kalman_means
@@ -51,7 +51,7 @@ def test_log_evidence_matches_kalman_marginal_likelihood():
         exact += -0.5 * (np.log(2 * np.pi * s) + (z - MODEL.c * mean) ** 2 / s)
         gain = var * MODEL.c / s
         mean, var = mean + gain * (z - MODEL.c * mean), (1 - gain * MODEL.c) * var
-    estimate = bootstrap(20_000, {"ess_threshold": 1.0}).run(MODEL, observations, np.random.default_rng(2))
+    estimate = bootstrap(20_000, ess_threshold=1.0).run(MODEL, observations, np.random.default_rng(2))
     assert estimate.log_evidence == pytest.approx(exact, abs=0.1)
 
 
@@ -77,9 +77,9 @@ def test_resampling_policy_threshold():
     rng = np.random.default_rng(0)
     model = UNGM(steps=40)
     observations = model.simulate(rng)[1]
-    always = bootstrap(100, {"ess_threshold": 1.0}).run(model, observations, np.random.default_rng(1))
-    never = bootstrap(100, {"ess_threshold": 0.0}).run(model, observations, np.random.default_rng(1))
-    adaptive = bootstrap(100, {"ess_threshold": 0.5}).run(model, observations, np.random.default_rng(1))
+    always = bootstrap(100, ess_threshold=1.0).run(model, observations, np.random.default_rng(1))
+    never = bootstrap(100, ess_threshold=0.0).run(model, observations, np.random.default_rng(1))
+    adaptive = bootstrap(100, ess_threshold=0.5).run(model, observations, np.random.default_rng(1))
     assert always.resample_count == 40 and never.resample_count == 0
     assert 0 < adaptive.resample_count < 40
     # adaptive resampling happens exactly at the steps whose ESS fell under N/2
@@ -116,7 +116,7 @@ def test_no_global_random_state_is_touched():
     model = UNGM(steps=10)
     observations = model.simulate(np.random.default_rng(0))[1]
     for scheme in ("multinomial", "systematic", "stratified", "residual"):
-        bootstrap(50, {"scheme": scheme, "ess_threshold": 1.0}).run(model, observations, np.random.default_rng(1))
+        bootstrap(50, scheme, 1.0).run(model, observations, np.random.default_rng(1))
     np.testing.assert_array_equal(np.random.get_state()[1], before)
 
 

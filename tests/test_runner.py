@@ -36,7 +36,7 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
         (("experiment=gps_qmcpf_ungm", "scale=huge"), "scale must be one of"),
         (("experiment=gps_qmcpf_ungm", "experiment.model.name=lorenz"), "unknown model 'lorenz'"),
         (("experiment=gps_qmcpf_ungm", "experiment.model.Q=-1"), "noise variances must be positive"),
-        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.resampling.scheme=bogus"), "unknown resampling"),
+        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.resampling=bogus"), "unknown resampling"),
     ],
 )
 def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):

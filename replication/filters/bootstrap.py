@@ -3,6 +3,6 @@
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 
 
-def bootstrap(n_particles: int, resampling: dict | None = None) -> ParticleFilter:
-    """Prior proposal, weights by the likelihood, resampling per ``resampling`` (scheme, ess_threshold)."""
-    return ParticleFilter(n_particles=n_particles, resampling=ResamplingPolicy(**(resampling or {})))
+def bootstrap(n_particles: int, resampling: str = "systematic", ess_threshold: float = 0.5) -> ParticleFilter:
+    """Prior proposal, weights by the likelihood; resample with ``resampling`` when ESS < ess_threshold * N."""
+    return ParticleFilter(n_particles=n_particles, resampling=ResamplingPolicy(resampling, ess_threshold))

@@ -12,10 +12,10 @@ from omegaconf import DictConfig, OmegaConf
 
 import replication
 from replication.paths import resolve
-from replication.report.figures import FIGURES
+from replication.report.figures import draw
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
-from replication.report.tables import build_table, format_table
+from replication.report.tables import build_summary_table, build_table, format_table
 from replication.report.verdict import RULES
 from replication.runner.config import Run
 from replication.runner.store import Store
@@ -32,6 +32,12 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     tables, figures, matched, verdicts = [], [], set(), Counter()
     if len(records):
         for table_spec in spec.get("tables", []):
+            if "metrics" in table_spec:  # our numbers only, several metrics side by side
+                table = build_summary_table(records, table_spec, experiment)
+                csv = f"{table_spec['name']}.csv"
+                table.to_csv(out / csv, index=False)
+                tables.append({"title": table_spec["title"], "html": html_table(table), "csv": csv})
+                continue
             table, hits = build_table(records, table_spec, experiment, published)
             matched |= hits
             verdicts.update(v.split(" (")[0] for v in table["verdict"])
@@ -42,10 +48,10 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             tables.append({"title": table_spec["title"], "html": html, "csv": csv})
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
-            FIGURES[figure_spec["kind"]](records, figure_spec, experiment["methods"], out / file)
+            draw(records, figure_spec, experiment, out / file)
             figures.append({"title": figure_spec["title"], "file": file})
-        records.to_csv(out / "runs.csv", index=False)
-    paper_tables = {str(t["paper_table"]) for t in spec.get("tables", [])}
+        records.drop(columns=["per_frame"], errors="ignore").to_csv(out / "runs.csv", index=False)
+    paper_tables = {str(t["paper_table"]) for t in spec.get("tables", []) if "paper_table" in t}
     unmatched = pd.concat(
         [cells(published, experiment["paper"], t) for t in sorted(paper_tables)] or [pd.DataFrame()]
     )

@@ -15,12 +15,13 @@ def parse_condition(condition: str) -> dict[str, str]:
     return dict(part.split("=", 1) for part in condition.split(";") if part)
 
 
-def metric_vs_condition(records: pd.DataFrame, spec: dict, methods: dict, path: Path) -> Path:
+def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
     A method that does not sweep ``x`` (the point-mass reference, say) is drawn
     as a horizontal band.
     """
+    methods = experiment["methods"]
     summary = summarise(records, spec["metric"])
     conditions = summary["condition"].map(parse_condition)
     summary["x"] = conditions.map(lambda c: float(c.get(spec["x"], "nan")))
@@ -51,4 +52,20 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, methods: dict, path: 
     return path
 
 
-FIGURES = {"metric_vs_condition": metric_vs_condition}
+def _figures():
+    from replication.report.tracking_figures import per_frame_curve, snapshots, track
+
+    return {
+        "metric_vs_condition": metric_vs_condition,
+        "per_frame_curve": per_frame_curve,
+        "track": track,
+        "snapshots": snapshots,
+    }
+
+
+def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``."""
+    figures = _figures()
+    if spec["kind"] not in figures:
+        raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(figures)}")
+    return figures[spec["kind"]](records, spec, experiment, path)

@@ -52,6 +52,28 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
     return pd.DataFrame(rows), matched
 
 
+def build_summary_table(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
+    """One row per method and condition, one column per metric: 'mean [95% CI]' over runs."""
+    columns = {}
+    for metric in spec["metrics"]:
+        summary = summarise(records, metric)
+        columns[metric] = {
+            (m, c): f"{mean:.4g} [{lo:.4g}, {hi:.4g}]" if np.isfinite(lo) else f"{mean:.4g}"
+            for m, c, mean, lo, hi in zip(summary["method"], summary["condition"], summary["mean"], summary["ci_low"], summary["ci_high"])
+        }
+    keys = list(columns[spec["metrics"][0]])
+    table = pd.DataFrame(
+        {
+            "method": [experiment["methods"][m].get("label", m) for m, _ in keys],
+            "condition": [c or "-" for _, c in keys],
+            "runs": [int((records["method"] == m).where(records["condition"] == c, False).sum()) for m, c in keys],
+        }
+    )
+    for metric, values in columns.items():
+        table[metric] = [values.get(key, "") for key in keys]
+    return table
+
+
 def excess_over_floor(records: pd.DataFrame, floor_methods: list[str]) -> dict:
     """Paired RMSE minus the point-mass filter's RMSE on the same trajectory: mean and 95% interval.
 

@@ -1,7 +1,8 @@
 """Validate an experiment config and expand it into independent runs.
 
-A value given as a list under ``model`` or under a method is a sweep: the runs
-are the product method x sweep values x repetition.  Everything is checked
+A list given directly under ``model`` or directly under a method is a sweep:
+the runs are the product method x sweep values x repetition.  Nested values
+(a motion, an observation model, a scene) are parameters, lists included.  Everything is checked
 before any work starts, and errors are one line that names the bad key.
 """
 
@@ -16,7 +17,6 @@ from omegaconf import DictConfig, OmegaConf
 
 import replication
 from replication.filters import FILTERS
-from replication.models import MODELS
 from replication.runner.seeding import seed_sequence
 
 SCALES = ("paper", "quick")
@@ -96,17 +96,25 @@ def n_runs(cfg: DictConfig) -> int:
     return runs
 
 
-def expand(cfg: DictConfig) -> list[Run]:
-    """All runs of ``cfg.experiment`` at ``cfg.scale``, validated."""
+def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
+    """All runs of ``cfg.experiment`` at ``cfg.scale``, validated.
+
+    Conditions whose data are absent (a real sequence not on this machine) are
+    left out, with a message appended to ``skipped``.
+    """
+    from replication.tasks import TASKS, DataMissing
+
     exp = cfg.experiment
     repetitions = n_runs(cfg)
+    if exp.get("task") not in TASKS:
+        raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
+    task = TASKS[exp.task]
     model = OmegaConf.to_container(exp.model, resolve=True)
-    if model.get("name") not in MODELS:
-        raise ConfigError(f"unknown model {model.get('name')!r}; known models: {', '.join(sorted(MODELS))}")
+    scenes = OmegaConf.to_container(exp.scenes, resolve=True) if "scenes" in exp else {}
     methods = OmegaConf.to_container(exp.methods, resolve=True)
     if not methods:
         raise ConfigError("experiment.methods is empty")
-    runs = []
+    runs, skipped = [], [] if skipped is None else skipped
     for method, params in methods.items():
         if params.get("filter") not in FILTERS:
             what = f"unknown filter {params['filter']!r}" if "filter" in params else "no 'filter:' key"
@@ -121,7 +129,20 @@ def expand(cfg: DictConfig) -> list[Run]:
                 if on_model:
                     data_labels.append(labels[-1])
             condition = ";".join(labels)
-            build_model(run_model, context=f"model ({condition or 'default'})")
+            if "scene" in run_model:
+                if run_model["scene"] not in scenes:
+                    raise ConfigError(f"model.scene {run_model['scene']!r} is not in experiment.scenes {sorted(scenes)}")
+                run_model["scene_spec"] = scenes[run_model["scene"]]
+            try:
+                task.check(run_model, run_params)
+            except DataMissing as missing:
+                message = f"{exp.name}: {missing}"
+                if message not in skipped:
+                    skipped.append(message)
+                continue
+            except (TypeError, ValueError, KeyError) as error:
+                where = f" ({condition})" if condition else ""
+                raise ConfigError(f"model{where}: {error}") from None
             build_filter(method, run_params, condition)
             key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed))
             runs.extend(
@@ -132,14 +153,6 @@ def expand(cfg: DictConfig) -> list[Run]:
                 for r in range(repetitions)
             )
     return runs
-
-
-def build_model(params: dict[str, Any], context: str = "model"):
-    kwargs = {k: v for k, v in params.items() if k != "name"}
-    try:
-        return MODELS[params["name"]](**kwargs)
-    except (TypeError, ValueError) as error:
-        raise ConfigError(f"{context}: {error}") from None
 
 
 def build_filter(method: str, params: dict[str, Any], condition: str = ""):

@@ -18,7 +18,7 @@ TIMING_COLUMNS = ("wall_s", "ms_per_step")
 def perform(run: Run) -> dict:
     """One run: a pure function of the run's identity, parameters and seed."""
     started = time.perf_counter()
-    metrics = TASKS[run.task](run)
+    metrics = TASKS[run.task].run(run)
     return {
         **run.identity(),
         **metrics,

@@ -1,10 +1,13 @@
 """Tasks bind a dataset (model or scene), a method and the metrics into one run.
 
-A task is ``run -> dict of metrics``; the experiment config names it with ``task:``.
+A task is a module with ``check(model, method)`` (raise ``ValueError`` for a
+bad config, :class:`DataMissing` for absent data) and ``run(run) -> dict``; the
+experiment config names it with ``task:``.
 """
 
-from replication.tasks.scalar import scalar
+from replication.scenes.factory import SequenceMissing as DataMissing
+from replication.tasks import scalar, tracking
 
-TASKS = {"scalar": scalar}
+TASKS = {"scalar": scalar, "tracking": tracking}
 
-__all__ = ["TASKS"]
+__all__ = ["TASKS", "DataMissing"]

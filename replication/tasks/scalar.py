@@ -3,10 +3,21 @@
 import time
 
 from replication.metrics import filter_diagnostics, rmse
-from replication.runner.config import Run, build_filter, build_model
+from replication.models import MODELS
+from replication.runner.config import Run, build_filter
 
 
-def scalar(run: Run) -> dict:
+def build_model(params: dict):
+    if params.get("name") not in MODELS:
+        raise ValueError(f"unknown model {params.get('name')!r}; known models: {', '.join(sorted(MODELS))}")
+    return MODELS[params["name"]](**{k: v for k, v in params.items() if k != "name"})
+
+
+def check(model: dict, method: dict) -> None:
+    build_model(model)
+
+
+def run(run: Run) -> dict:
     """Simulate x_1..x_T, z_1..z_T from the ``data`` stream, filter with the ``filter`` stream, score.
 
     Every method at the same model condition and repetition sees the same

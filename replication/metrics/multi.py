@@ -1,0 +1,101 @@
+"""Multi-target metrics: mean error per target (bis_pf), track loss, CLEAR MOT and IDF1.
+
+Ground truth and hypotheses are centre tracks: ``truth`` (T, M, 2) with a
+presence mask (T, M), ``estimates`` (T, K, 2) with a presence mask (T, K).
+A truth-hypothesis pair can match in a frame when their distance is below
+``threshold`` px.
+
+CLEAR MOT (Bernardin and Stiefelhagen 2008), as py-motmetrics computes it:
+each frame first keeps last frame's pairs that are still within the threshold,
+then assigns the rest by minimum total distance (Hungarian); a truth matched to
+a hypothesis other than the one it was last matched to is an identity switch.
+MOTA = 1 - (misses + false positives + switches) / truth detections;
+MOTP = mean distance over matches.  IDF1 (Ristani et al. 2016): one global
+one-to-one assignment of truth tracks to hypothesis tracks maximising the frames
+they match (IDTP); IDF1 = 2 IDTP / (truth detections + hypothesis detections).
+"""
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+UNMATCHABLE = 1e9
+
+
+def mean_error_per_target(estimates: np.ndarray, truth: np.ndarray) -> float:
+    """bis_pf's error: mean over frames and targets of |estimate_m - truth_m| (px), estimate m for target m."""
+    return float(np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1).mean())
+
+
+def track_losses(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
+    """(M,) bool: target m is lost when its estimate stays over ``threshold`` px away for ``patience`` frames."""
+    far = np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1) > threshold
+    run = np.zeros(far.shape[1], dtype=int)
+    lost = np.zeros(far.shape[1], dtype=bool)
+    for row in far:
+        run = np.where(row, run + 1, 0)
+        lost |= run >= patience
+    return lost
+
+
+def _distances(truth_k, estimates_k, threshold):
+    d = np.linalg.norm(truth_k[:, None, :] - estimates_k[None, :, :], axis=-1)
+    return np.where(d < threshold, d, np.nan)
+
+
+def clear_mot(truth, estimates, threshold, truth_present=None, estimate_present=None) -> dict:
+    """MOTA, MOTP, switches, misses, false positives and matches over all frames."""
+    truth, estimates = np.asarray(truth, float), np.asarray(estimates, float)
+    truth_present = np.ones(truth.shape[:2], bool) if truth_present is None else np.asarray(truth_present)
+    estimate_present = np.ones(estimates.shape[:2], bool) if estimate_present is None else np.asarray(estimate_present)
+    last = {}
+    matches = switches = misses = false_positives = 0
+    total_distance = 0.0
+    for k in range(len(truth)):
+        oids, hids = np.flatnonzero(truth_present[k]), np.flatnonzero(estimate_present[k])
+        d = _distances(truth[k, oids], estimates[k, hids], threshold)
+        o_done, h_done = np.zeros(len(oids), bool), np.zeros(len(hids), bool)
+        pairs = []
+        for i, o in enumerate(oids):  # 1. keep last frame's correspondences that still hold
+            if o in last:
+                j = np.flatnonzero((hids == last[o]) & ~h_done)
+                if len(j) and np.isfinite(d[i, j[0]]):
+                    o_done[i], h_done[j[0]] = True, True
+                    pairs.append((i, j[0], False))
+        rest = d.copy()
+        rest[o_done, :] = np.nan
+        rest[:, h_done] = np.nan
+        if rest.size:
+            rows, cols = linear_sum_assignment(np.where(np.isfinite(rest), rest, UNMATCHABLE))
+            for i, j in zip(rows, cols):
+                if np.isfinite(rest[i, j]):
+                    o_done[i], h_done[j] = True, True
+                    pairs.append((i, j, oids[i] in last and last[oids[i]] != hids[j]))
+        for i, j, switched in pairs:
+            last[oids[i]] = hids[j]
+            total_distance += d[i, j]
+            switches += switched
+        matches += len(pairs)
+        misses += int((~o_done).sum())
+        false_positives += int((~h_done).sum())
+    n_truth = int(truth_present.sum())
+    return {
+        "mota": 1.0 - (misses + false_positives + switches) / n_truth,
+        "motp": total_distance / matches if matches else float("nan"),
+        "switches": int(switches),
+        "misses": misses,
+        "false_positives": false_positives,
+        "matches": matches,
+    }
+
+
+def idf1(truth, estimates, threshold, truth_present=None, estimate_present=None) -> float:
+    """IDF1 from the global truth-to-hypothesis assignment maximising matched frames."""
+    truth, estimates = np.asarray(truth, float), np.asarray(estimates, float)
+    truth_present = np.ones(truth.shape[:2], bool) if truth_present is None else np.asarray(truth_present)
+    estimate_present = np.ones(estimates.shape[:2], bool) if estimate_present is None else np.asarray(estimate_present)
+    close = np.linalg.norm(truth[:, :, None, :] - estimates[:, None, :, :], axis=-1) < threshold
+    both = truth_present[:, :, None] & estimate_present[:, None, :]
+    counts = (close & both).sum(axis=0)  # (M, K) frames each pair matches
+    rows, cols = linear_sum_assignment(-counts)
+    idtp = counts[rows, cols].sum()
+    return float(2 * idtp / (truth_present.sum() + estimate_present.sum()))

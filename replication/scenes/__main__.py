@@ -1,0 +1,35 @@
+"""``python -m replication.scenes experiment=<name> [out=DIR] [format=mp4|images] [boxes=true]``.
+
+Writes the scene of an experiment (its ``scene:`` block) so it can be watched.
+"""
+
+import sys
+from pathlib import Path
+
+from hydra import compose, initialize_config_dir
+from omegaconf import OmegaConf
+
+from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.runner.cli import fail
+from replication.scenes.export import write_sequence
+from replication.scenes.factory import build_sequence
+
+
+def main(argv: list[str]) -> None:
+    options = dict(arg.split("=", 1) for arg in argv if "=" in arg)
+    name = options.pop("experiment", None)
+    if name not in experiment_names():
+        fail(f"name an experiment with a scene: experiment=<name>; known: {', '.join(experiment_names())}")
+    out = Path(options.pop("out", str(resolve("reports") / "scenes")))
+    video = options.pop("format", "mp4") == "mp4"
+    boxes = options.pop("boxes", "false").lower() == "true"
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=[f"experiment={name}"])
+    if "scene" not in cfg.experiment:
+        fail(f"experiment {name!r} has no scene")
+    sequence = build_sequence(OmegaConf.to_container(cfg.experiment.scene, resolve=True))
+    print(write_sequence(sequence, out, video=video, boxes=boxes))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,79 @@
+"""Real sequences in the OTB layout: ``img/0001.jpg ...`` and ``groundtruth_rect*.txt``.
+
+OTB boxes are 1-based (x, y, w, h); they are turned into our 0-based boxes by
+subtracting 1 from x and y.  Separators vary (comma, TAB, spaces) and some files
+use CRLF, so rows are split on ``[,\\s]+``.
+"""
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from replication.paths import resolve
+
+OTB_ROOT = "../shared/data/otb"
+# Sequences whose usual ground-truth file is not groundtruth_rect.txt (see SOURCES.md).
+GROUNDTRUTH_FILES = {"Jogging-1": ("Jogging", "groundtruth_rect.1.txt"), "Jogging-2": ("Jogging", "groundtruth_rect.2.txt")}
+
+
+def read_groundtruth(path: Path) -> np.ndarray:
+    """Boxes (T, 4) from an OTB ground-truth file, converted to 0-based coordinates."""
+    rows = [
+        [float(v) for v in re.split(r"[,\s]+", line.strip())]
+        for line in path.read_text().splitlines()
+        if line.strip()
+    ]
+    boxes = np.array(rows, dtype=float)
+    if boxes.ndim != 2 or boxes.shape[1] != 4:
+        raise ValueError(f"{path}: expected 4 numbers per line")
+    boxes[:, :2] -= 1.0
+    return boxes
+
+
+@dataclass
+class OTBSequence:
+    """One OTB sequence, frames read lazily; grey JPEGs are returned as 3-channel BGR."""
+
+    name: str
+    root: str = OTB_ROOT
+    first: int = 0
+    last: int | None = None
+    stand_in: str | None = None
+    _frames: list[Path] = field(init=False, repr=False)
+
+    def __post_init__(self):
+        folder, gt_name = GROUNDTRUTH_FILES.get(self.name, (self.name, "groundtruth_rect.txt"))
+        directory = resolve(self.root) / folder
+        truth = read_groundtruth(directory / gt_name)
+        frames = sorted((directory / "img").glob("*.jpg"))
+        if len(frames) != len(truth):
+            raise ValueError(f"{directory}: {len(frames)} frames but {len(truth)} ground-truth boxes")
+        stop = len(frames) if self.last is None else self.last
+        self._frames = frames[self.first : stop]
+        self.truth = truth[self.first : stop, None, :]
+        self.visibility = np.ones(self.truth.shape[:2])
+        self.n_frames = len(self._frames)
+        height, width = self.frame(0).shape[:2]
+        self.size = (width, height)
+
+    def frame(self, k: int) -> np.ndarray:
+        image = cv2.imread(str(self._frames[k]), cv2.IMREAD_COLOR)
+        if image is None:
+            raise OSError(f"cannot read {self._frames[k]}")
+        return image
+
+
+def find_otb(names: list[str], root: str = OTB_ROOT) -> tuple[list[str], list[str]]:
+    """Split ``names`` into the sequences present under ``root`` and messages for the absent ones."""
+    present, missing = [], []
+    for name in names:
+        folder, gt_name = GROUNDTRUTH_FILES.get(name, (name, "groundtruth_rect.txt"))
+        directory = resolve(root) / folder
+        if (directory / gt_name).exists() and (directory / "img").is_dir():
+            present.append(name)
+        else:
+            missing.append(f"OTB sequence {name!r} is not in {directory.parent}: skipped")
+    return present, missing

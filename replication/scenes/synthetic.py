@@ -1,0 +1,297 @@
+"""Synthetic scenes rendered with OpenCV, with exact ground truth.
+
+A scene is declared as a dict (from Hydra config), for example::
+
+    size: [320, 240]                 # width, height
+    frames: 150
+    seed: 0                          # textures, random-walk paths, camera noise
+    background: {kind: clutter, colour: [60, 90, 60], like_target: 0, patches: 12}
+    camera_noise: 2.0                # sd of Gaussian pixel noise (grey levels)
+    illumination: [{start: 40, end: 60, gain: 0.5}]
+    targets:
+      - shape: head                  # ellipse | box | ball | head
+        size: [30, 40]               # width, height at scale 1
+        colour: [70, 110, 210]       # BGR
+        back_colour: [30, 40, 60]    # what a head shows when it turns away
+        appearance: [{start: 90, end: 110, to: back}, {start: 130, end: 140, to: front}]
+        motion: {kind: scripted, keyframes: [[0, 60, 50], [149, 260, 180]]}
+        scale: [[0, 1.0], [149, 1.4]]
+        depth: 1                     # smaller is nearer
+    occluders:
+      - {shape: box, size: [40, 120], colour: [20, 20, 20], depth: 0,
+         motion: {kind: scripted, keyframes: [[0, 160, 120]]}}
+
+Motion kinds: ``scripted`` (linear between keyframes [frame, cx, cy]),
+``velocity`` (piecewise constant velocity: start [cx, cy], segments
+[[frame, vx, vy], ...]; a sudden speed change is a new segment) and
+``random_walk`` (constant velocity disturbed by Gaussian noise of variance
+``noise_var`` per frame, speed capped at ``max_speed``, bouncing off the
+borders: the bis_pf tennis balls).
+
+Camera noise is i.i.d. Gaussian per pixel within a frame; to keep rendering
+cheap, frame k reads it from one stored noise bank at an offset drawn from
+(seed, k), so frames are reproducible in any order.
+
+Objects are drawn back to front at whole-pixel positions; the truth box is the
+box actually drawn, and the visibility of a target is the fraction of its
+sprite's pixels that are inside the frame and not covered by a nearer object.
+"""
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import cv2
+import numpy as np
+
+SHAPES = ("ellipse", "box", "ball", "head")
+BACKGROUNDS = ("flat", "gradient", "noise", "clutter")
+MOTIONS = ("scripted", "velocity", "random_walk")
+NOISE_OFFSETS = 1 << 16
+
+
+class SceneError(ValueError):
+    """A scene description that cannot be rendered."""
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise SceneError(message)
+
+
+def _ramp(frames: np.ndarray, start: int, end: int) -> np.ndarray:
+    """0 before ``start``, 1 after ``end``, linear in between."""
+    return np.clip((frames - start) / max(end - start, 1), 0.0, 1.0)
+
+
+def trajectory(motion: dict, n_frames: int, size: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
+    """Centres (n_frames, 2) of an object under ``motion``."""
+    kind = motion.get("kind")
+    _require(kind in MOTIONS, f"unknown motion {kind!r}; choose one of {MOTIONS}")
+    frames = np.arange(n_frames)
+    if kind == "scripted":
+        keys = np.asarray(motion["keyframes"], dtype=float)
+        _require(keys.ndim == 2 and keys.shape[1] == 3, "scripted keyframes are [frame, cx, cy] rows")
+        return np.column_stack([np.interp(frames, keys[:, 0], keys[:, 1]), np.interp(frames, keys[:, 0], keys[:, 2])])
+    if kind == "velocity":
+        segments = sorted(motion["segments"])
+        velocity = np.zeros((n_frames, 2))
+        for start, vx, vy in segments:
+            velocity[int(start) :] = (vx, vy)
+        steps = np.vstack([[0.0, 0.0], velocity[1:]])
+        return np.asarray(motion["start"], dtype=float) + np.cumsum(steps, axis=0)
+    # random walk with a speed cap, reflected at the borders
+    centre = np.asarray(motion["start"], dtype=float) if "start" in motion else rng.uniform((0, 0), size)
+    velocity = np.asarray(motion.get("velocity", rng.normal(0.0, 1.0, 2)), dtype=float)
+    sd, cap, margin = np.sqrt(motion.get("noise_var", 0.4)), motion.get("max_speed", 2.0), motion.get("margin", 10)
+    low, high = np.array([margin, margin]), np.array(size, dtype=float) - margin
+    path = np.empty((n_frames, 2))
+    for k in range(n_frames):
+        path[k] = centre
+        velocity = velocity + sd * rng.standard_normal(2)
+        speed = np.hypot(*velocity)
+        if speed > cap:
+            velocity *= cap / speed
+        centre = centre + velocity
+        for axis in range(2):
+            if not low[axis] <= centre[axis] <= high[axis]:
+                velocity[axis] = -velocity[axis]
+                centre[axis] = np.clip(centre[axis], low[axis], high[axis])
+    return path
+
+
+def _textured(colour, spread: float, shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
+    """A float32 (h, w, 3) patch of ``colour`` with per-pixel noise of sd ``spread`` (smoothed a little)."""
+    noise = rng.normal(0.0, spread, (*shape, 3)).astype(np.float32)
+    if spread > 0:
+        noise = cv2.GaussianBlur(noise, (3, 3), 0)
+    return np.clip(np.asarray(colour, np.float32) + noise, 0, 255)
+
+
+def sprite(spec: dict, face: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Colour (h, w, 3) float32 and alpha (h, w) float32 of an object at scale 1."""
+    shape = spec.get("shape", "ellipse")
+    _require(shape in SHAPES, f"unknown shape {shape!r}; choose one of {SHAPES}")
+    w, h = (int(v) for v in spec["size"])
+    _require(w >= 2 and h >= 2, f"object size must be at least 2x2 px, got {w}x{h}")
+    colour = spec["colour"] if face == "front" else spec.get("back_colour", spec["colour"])
+    image = _textured(colour, spec.get("colour_spread", 12.0), (h, w), rng)
+    alpha = np.zeros((h, w), np.float32)
+    centre, axes = (w // 2, h // 2), (max(w // 2 - 1, 1), max(h // 2 - 1, 1))
+    if shape == "box":
+        alpha[:] = 1.0
+    else:
+        cv2.ellipse(alpha, centre, axes, 0, 0, 360, 1.0, -1, cv2.LINE_AA)
+    if shape == "ball":  # shading: lighter towards the upper left
+        yy, xx = np.mgrid[0:h, 0:w]
+        light = 1.25 - 0.5 * np.hypot((xx - 0.35 * w) / w, (yy - 0.35 * h) / h)
+        image = np.clip(image * light[..., None], 0, 255)
+    structure = spec.get("structure", shape in ("head", "box"))
+    dark = tuple(float(c) * 0.25 for c in spec.get("structure_colour", (40, 40, 40)))
+    if shape == "head":
+        hair = np.asarray(spec.get("back_colour", (30, 40, 60)), np.float32)
+        top = np.zeros((h, w), np.float32)
+        cv2.ellipse(top, centre, axes, 0, 180, 360, 1.0, -1)
+        cut = int(h * 0.3) if face == "front" else h
+        top[cut:] = 0.0
+        image[top > 0] = hair
+        if face == "front" and structure:
+            for ex in (0.33, 0.67):
+                cv2.circle(image, (int(w * ex), int(h * 0.45)), max(w // 12, 1), dark, -1)
+            cv2.line(image, (int(w * 0.35), int(h * 0.72)), (int(w * 0.65), int(h * 0.72)), dark, max(h // 20, 1))
+    elif structure:
+        cv2.line(image, (w // 2, 1), (w // 2, h - 2), dark, max(w // 10, 1))
+        cv2.line(image, (1, h // 2), (w - 2, h // 2), dark, max(h // 10, 1))
+    return image, alpha
+
+
+@dataclass
+class _Object:
+    spec: dict
+    centres: np.ndarray
+    scales: np.ndarray
+    turned: np.ndarray
+    sprites: dict
+    depth: float
+    target: int | None
+
+    def drawn(self, k: int) -> tuple[np.ndarray, np.ndarray, int, int]:
+        """Colour, alpha and top-left corner of the object in frame k."""
+        front_image, alpha = self.sprites["front"]
+        w, h = alpha.shape[1], alpha.shape[0]
+        sw, sh = max(int(round(w * self.scales[k])), 2), max(int(round(h * self.scales[k])), 2)
+        image = front_image
+        if self.turned[k] > 0:
+            image = (1 - self.turned[k]) * front_image + self.turned[k] * self.sprites["back"][0]
+        if (sw, sh) != (w, h):
+            image = cv2.resize(image, (sw, sh), interpolation=cv2.INTER_LINEAR)
+            alpha = cv2.resize(alpha, (sw, sh), interpolation=cv2.INTER_LINEAR)
+        x0 = int(round(self.centres[k, 0] - sw / 2))
+        y0 = int(round(self.centres[k, 1] - sh / 2))
+        return image, alpha, x0, y0
+
+
+def _clip(x0: int, y0: int, w: int, h: int, width: int, height: int):
+    """Slices of the frame and of a (h, w) sprite at (x0, y0) for their overlap, or None."""
+    fx0, fy0, fx1, fy1 = max(x0, 0), max(y0, 0), min(x0 + w, width), min(y0 + h, height)
+    if fx0 >= fx1 or fy0 >= fy1:
+        return None
+    return (slice(fy0, fy1), slice(fx0, fx1)), (slice(fy0 - y0, fy1 - y0), slice(fx0 - x0, fx1 - x0))
+
+
+class SyntheticScene:
+    """A rendered scene: ``frame(k)``, ``truth`` (T, M, 4), ``visibility`` (T, M)."""
+
+    def __init__(self, spec: dict, name: str = "synthetic", stand_in: str | None = None):
+        self.spec, self.name, self.stand_in = spec, name, stand_in
+        _require("size" in spec and "frames" in spec, "a scene needs size: [width, height] and frames:")
+        self.size = tuple(int(v) for v in spec["size"])
+        self.n_frames = int(spec["frames"])
+        _require(self.size[0] >= 8 and self.size[1] >= 8 and self.n_frames >= 1, "scene too small")
+        _require(len(spec.get("targets", [])) >= 1, "a scene needs at least one target")
+        self.seed = int(spec.get("seed", 0))
+        rng = np.random.default_rng(self.seed)
+        self.background = self._background(spec.get("background", {"kind": "flat"}), rng)
+        self.objects = [self._object(t, i, rng) for i, t in enumerate(spec["targets"])]
+        self.objects += [self._object(o, None, rng) for o in spec.get("occluders", [])]
+        self.order = sorted(range(len(self.objects)), key=lambda i: -self.objects[i].depth)  # far to near
+        frames = np.arange(self.n_frames)
+        self.gain = np.ones(self.n_frames)
+        for change in spec.get("illumination", []):
+            self.gain *= 1.0 + (change["gain"] - 1.0) * _ramp(frames, change["start"], change["end"])
+        self.camera_noise = float(spec.get("camera_noise", 0.0))
+        if self.camera_noise > 0:  # one bank of noise; frame k reads it from its own random offset
+            pixels = self.size[0] * self.size[1] * 3
+            self._noise = self.camera_noise * rng.standard_normal(pixels + NOISE_OFFSETS, dtype=np.float32)
+        self.truth = np.stack([self._boxes(obj) for obj in self.objects if obj.target is not None], axis=1)
+
+    def _object(self, spec: dict, target: int | None, rng: np.random.Generator) -> _Object:
+        frames = np.arange(self.n_frames)
+        centres = trajectory(spec.get("motion", {"kind": "scripted", "keyframes": [[0, *np.divide(self.size, 2)]]}),
+                             self.n_frames, self.size, rng)
+        keys = np.asarray(spec.get("scale", [[0, 1.0]]), dtype=float)
+        scales = np.interp(frames, keys[:, 0], keys[:, 1])
+        turned = np.zeros(self.n_frames)
+        for change in spec.get("appearance", []):
+            _require(change.get("to") in ("back", "front"), "appearance changes go 'to: back' or 'to: front'")
+            ramp = _ramp(frames, change["start"], change["end"])
+            turned = np.maximum(turned, ramp) if change["to"] == "back" else np.minimum(turned, 1.0 - ramp)
+        sprites = {"front": sprite(spec, "front", rng), "back": sprite(spec, "back", rng)}
+        return _Object(spec, centres, scales, turned, sprites, float(spec.get("depth", 1.0)), target)
+
+    def _background(self, spec: dict, rng: np.random.Generator) -> np.ndarray:
+        kind = spec.get("kind", "flat")
+        _require(kind in BACKGROUNDS, f"unknown background {kind!r}; choose one of {BACKGROUNDS}")
+        width, height = self.size
+        colour = np.asarray(spec.get("colour", (90, 90, 90)), np.float32)
+        if kind == "gradient":
+            end = np.asarray(spec.get("to_colour", colour * 0.5), np.float32)
+            ramp = np.linspace(0.0, 1.0, height, dtype=np.float32)[:, None, None]
+            return np.broadcast_to(colour + (end - colour) * ramp, (height, width, 3)).copy()
+        if kind == "flat":
+            return np.broadcast_to(colour, (height, width, 3)).copy()
+        scale, amplitude = int(spec.get("scale", 8)), spec.get("amplitude", 25.0)
+        grid = (height // scale + 1, width // scale + 1)
+        small = rng.normal(0.0, amplitude, (*grid, 1)) + rng.normal(0.0, spec.get("chroma", amplitude / 4), (*grid, 3))
+        image = colour + cv2.resize(small.astype(np.float32), (width, height), interpolation=cv2.INTER_CUBIC)
+        if kind == "clutter":  # patches coloured like a target: the hard case for colour-only tracking
+            like = self.spec["targets"][int(spec.get("like_target", 0))]
+            pw, ph = spec.get("patch_size", like["size"])
+            for _ in range(int(spec.get("patches", 10))):
+                patch_spec = {**like, "size": [pw, ph], "structure": False, "shape": spec.get("patch_shape", "ellipse")}
+                patch, alpha = sprite(patch_spec, "front", rng)
+                x0, y0 = int(rng.integers(0, width - pw)), int(rng.integers(0, height - ph))
+                region = image[y0 : y0 + ph, x0 : x0 + pw]
+                region[:] = region * (1 - alpha[..., None]) + patch * alpha[..., None]
+        return np.clip(image, 0, 255).astype(np.float32)
+
+    def _boxes(self, obj: _Object) -> np.ndarray:
+        boxes = np.empty((self.n_frames, 4))
+        for k in range(self.n_frames):
+            _, alpha, x0, y0 = obj.drawn(k)
+            boxes[k] = (x0, y0, alpha.shape[1], alpha.shape[0])
+        return boxes
+
+    def frame(self, k: int) -> np.ndarray:
+        """Frame k as uint8 BGR: background, objects far to near, illumination, camera noise."""
+        if not 0 <= k < self.n_frames:
+            raise IndexError(f"frame {k} outside 0..{self.n_frames - 1}")
+        width, height = self.size
+        image = self.background.copy()
+        for index in self.order:
+            colour, alpha, x0, y0 = self.objects[index].drawn(k)
+            overlap = _clip(x0, y0, alpha.shape[1], alpha.shape[0], width, height)
+            if overlap is None:
+                continue
+            inside, part = overlap
+            a = alpha[part][..., None]
+            image[inside] = image[inside] * (1.0 - a) + colour[part] * a
+        if self.gain[k] != 1.0:
+            image *= self.gain[k]
+        if self.camera_noise > 0:
+            offset = int(np.random.default_rng([self.seed, 1, k]).integers(NOISE_OFFSETS))
+            image += self._noise[offset : offset + image.size].reshape(image.shape)
+        return np.clip(image, 0, 255).astype(np.uint8)
+
+    @cached_property
+    def visibility(self) -> np.ndarray:
+        """(T, M) share of each target's sprite pixels visible in the frame (label buffer, near wins)."""
+        width, height = self.size
+        n_targets = self.truth.shape[1]
+        visibility = np.zeros((self.n_frames, n_targets))
+        for k in range(self.n_frames):
+            labels = np.full((height, width), -1, np.int32)
+            areas = np.zeros(n_targets)
+            for index in self.order:
+                obj = self.objects[index]
+                _, alpha, x0, y0 = obj.drawn(k)
+                solid = alpha > 0.5
+                if obj.target is not None:
+                    areas[obj.target] = solid.sum()
+                overlap = _clip(x0, y0, alpha.shape[1], alpha.shape[0], width, height)
+                if overlap is None:
+                    continue
+                inside, part = overlap
+                labels[inside][solid[part]] = -1 if obj.target is None else obj.target
+            counts = np.bincount(labels.ravel() + 1, minlength=n_targets + 1)[1:]
+            visibility[k] = np.divide(counts, areas, out=np.zeros(n_targets), where=areas > 0)
+        return visibility
