@@ -31,10 +31,10 @@ replicate: setup
 	@for experiment in $(EXPERIMENTS); do \
 		$(BIN)/python -m replication experiment=$$experiment scale=$(SCALE) n_jobs=$(JOBS) || exit 1; \
 	done
-	$(BIN)/python -m replication.benchmark
+	$(BIN)/python benchmarks/benchmark.py
 
 benchmark: setup
-	$(BIN)/python -m replication.benchmark
+	$(BIN)/python benchmarks/benchmark.py
 
 report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)

@@ -36,10 +36,15 @@ def run_experiment(cfg: DictConfig) -> None:
     from replication.report.experiment import write_experiment_report
     from replication.report.index import write_index
 
+    skipped = []
     try:
-        runs = expand(cfg)
+        runs = expand(cfg, skipped)
     except ConfigError as error:
         fail(str(error))
+    for message in skipped:
+        print(f"skipped: {message}", file=sys.stderr)
+    if not runs:
+        fail(f"{cfg.experiment.name}: nothing to run (every condition was skipped)")
     if cfg.n_jobs == 0:
         fail("n_jobs must be a positive number of workers or -1 for all cores")
     store = Store(resolve(cfg.store), cfg.experiment.name)

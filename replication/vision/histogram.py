@@ -20,22 +20,33 @@ turns into -inf.
 """
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import cv2
 import numpy as np
 
 KERNELS = ("epanechnikov", "diagonal", "uniform")
+BLOCK = 64  # boxes per bincount: keeps the gathered indices and weights in cache
+
+
+_SUM_CHANNELS = np.ones((1, 3), np.float32)
+
+
+@lru_cache(maxsize=16)
+def _contributions(bins: tuple[int, int, int]) -> np.ndarray:
+    """(256, 1, 3) uint16 table: channel value -> its term in the joint bin index (OpenCV HSV ranges)."""
+    bh, bs, bv = bins
+    rows = [np.minimum(np.arange(256) * n // top, n - 1) * stride
+            for n, top, stride in ((bh, 180, bs * bv), (bs, 256, bv), (bv, 256, 1))]
+    return np.stack(rows, axis=-1)[:, None, :].astype(np.uint16)
 
 
 def hsv_bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
     """(H, W) uint16 image of joint HSV bin indices ``(h * Bs + s) * Bv + v`` of a BGR frame."""
-    bh, bs, bv = bins
     if max(bins) > 256:
         raise ValueError(f"at most 256 bins per channel, got {bins}")
-    lookup = np.stack([np.minimum(np.arange(256) * n // top, n - 1) for n, top in ((bh, 180), (bs, 256), (bv, 256))], -1)
-    binned = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), lookup.astype(np.uint8)[:, None, :]).astype(np.uint16)
-    h, s, v = cv2.split(binned)
-    return (h * bs + s) * bv + v
+    terms = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(tuple(bins)))
+    return cv2.transform(terms, _SUM_CHANNELS)
 
 
 def sample_pattern(kernel: str, grid: tuple[int, int] | None, samples: int | None, rng: np.random.Generator | None):
@@ -83,23 +94,29 @@ class ColourHistogram:
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height.
 
-        One ``cv2.remap`` (nearest neighbour) gathers the N x K bin indices;
-        points outside the image read a spare bin B that is dropped; one
-        ``np.bincount`` over particle-offset indices gives all N histograms.
+        One ``cv2.remap`` (nearest neighbour) gathers the bin indices of a block
+        of boxes; points outside the image read a spare bin B that is dropped;
+        one ``np.bincount`` over box-offset indices gives the block's
+        histograms.  Blocks of ``BLOCK`` boxes keep the work in cache.
         """
-        boxes = np.atleast_2d(boxes).astype(np.float32)
+        boxes = np.atleast_2d(np.asarray(boxes, dtype=float))
+        return np.vstack([self._block(bin_image, boxes[i : i + BLOCK]) for i in range(0, len(boxes), BLOCK)])
+
+    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         n, spare = len(boxes), self.n_bins
+        single = boxes.astype(np.float32)
         # sample k of box n sits at (cx + u_k w / 2, cy + v_k h / 2); pixel p covers [p, p + 1)
-        map_x = boxes[:, 0:1] - 0.5 + self._u[None, :] * (boxes[:, 2:3] / 2)
-        map_y = boxes[:, 1:2] - 0.5 + self._v[None, :] * (boxes[:, 3:4] / 2)
+        map_x = single[:, 0:1] - 0.5 + self._u[None, :] * (single[:, 2:3] / 2)
+        map_y = single[:, 1:2] - 0.5 + self._v[None, :] * (single[:, 3:4] / 2)
         gathered = cv2.remap(
             bin_image, map_x, map_y, cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT, borderValue=spare
         )
         index = gathered.astype(np.intp)
         index += (spare + 1) * np.arange(n, dtype=np.intp)[:, None]
         if self.kernel == "diagonal":  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
-            share = (boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)).astype(float)
-            weights = (1.0 - (self._u[None, :] ** 2 * share + self._v[None, :] ** 2 * (1.0 - share))).ravel()
+            share = boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)
+            u2, v2 = self.points[None, :, 0] ** 2, self.points[None, :, 1] ** 2
+            weights = (1.0 - (u2 * share + v2 * (1.0 - share))).ravel()
         else:
             weights = np.tile(self.weights, n)
         counts = np.bincount(index.ravel(), weights=weights, minlength=n * (spare + 1))

@@ -1,0 +1,90 @@
+"""Tracking metrics on hand-computed cases, and CLEAR MOT / IDF1 against py-motmetrics."""
+
+import numpy as np
+import pytest
+
+from replication.metrics import multi
+from replication.metrics import tracking as tm
+
+
+def test_centre_error_iou_and_deviation_hand_computed():
+    truth = np.array([[0, 0, 10, 10], [0, 0, 10, 10], [0, 0, 10, 10]], float)
+    est = np.array([[0, 0, 10, 10], [5, 0, 10, 10], [20, 20, 10, 10]], float)
+    np.testing.assert_allclose(tm.centre_error(est, truth), [0, 5, np.hypot(20, 20)])
+    np.testing.assert_allclose(tm.iou(est, truth), [1.0, 50 / 150, 0.0])
+    np.testing.assert_allclose(tm.deviation(est, truth), [[0, 0], [5, 0], [20, 20]])
+    assert tm.iou(np.array([0, 0, 0, 0.0]), np.array([0, 0, 0, 0.0])) == 0.0
+
+
+def test_precision_and_success_curves_follow_otb():
+    errors = np.array([0.0, 10.0, 20.0, 30.0])
+    assert tm.precision_at(errors) == 0.75  # <= 20 px
+    curve = tm.precision_curve(errors)
+    assert curve[0] == 0.25 and curve[20] == 0.75 and curve[50] == 1.0 and len(curve) == 51
+    overlaps = np.array([0.0, 0.5, 1.0])
+    success = tm.success_curve(overlaps)
+    assert len(success) == 21 and success[0] == pytest.approx(2 / 3)  # IoU > 0, strictly
+    assert success[10] == pytest.approx(1 / 3)  # IoU > 0.5 strictly: only the perfect frame
+    assert success[-1] == 0.0
+    assert tm.success_auc(overlaps) == pytest.approx(success.mean())
+    assert tm.success_auc(np.ones(5)) == pytest.approx(20 / 21)  # IoU = 1 fails only "> 1"
+
+
+def test_correct_tracking_rules_and_tracked_to_end():
+    errors, overlaps = np.array([5.0, 25.0, 8.0]), np.array([0.6, 0.0, 0.4])
+    np.testing.assert_array_equal(tm.correct_frames(errors, overlaps, "iou>=0.5"), [True, False, False])
+    np.testing.assert_array_equal(tm.correct_frames(errors, overlaps, "cle<=20"), [True, False, True])
+    with pytest.raises(ValueError, match="unknown correctness rule"):
+        tm.correct_frames(errors, overlaps, "vibes")
+    assert tm.tracked_to_end(np.array([1, 0, 0, 1, 1], bool), patience=3)
+    assert not tm.tracked_to_end(np.array([1, 0, 0, 0, 1], bool), patience=3)
+    assert not tm.tracked_to_end(np.array([1, 1, 1, 1, 0], bool), patience=3)
+
+
+def test_mean_error_per_target_and_track_loss():
+    truth = np.zeros((4, 2, 2))
+    est = np.zeros((4, 2, 2))
+    est[:, 1, 0] = [3, 30, 30, 4]
+    assert multi.mean_error_per_target(est, truth) == pytest.approx((3 + 30 + 30 + 4) / 8)
+    np.testing.assert_array_equal(multi.track_losses(est, truth, threshold=10, patience=2), [False, True])
+    np.testing.assert_array_equal(multi.track_losses(est, truth, threshold=10, patience=3), [False, False])
+
+
+def test_clear_mot_hand_case_with_a_swap():
+    # two targets 100 px apart; the tracker's estimates swap identities in frame 2
+    truth = np.array([[[0, 0], [100, 0]]] * 3, float)
+    est = np.array([[[1, 0], [100, 2]], [[1, 0], [100, 2]], [[100, 1], [0, 1]]], float)
+    result = multi.clear_mot(truth, est, threshold=10)
+    assert result["switches"] == 2 and result["misses"] == 0 and result["false_positives"] == 0
+    assert result["mota"] == pytest.approx(1 - 2 / 6)
+    assert result["motp"] == pytest.approx((1 + 2 + 1 + 2 + 1 + 1) / 6)
+    assert multi.idf1(truth, est, threshold=10) == pytest.approx(2 * 4 / 12)
+
+
+def motmetrics_summary(truth, est, threshold, truth_present, est_present):
+    mm = pytest.importorskip("motmetrics")
+    acc = mm.MOTAccumulator(auto_id=True)
+    for k in range(len(truth)):
+        oids, hids = np.flatnonzero(truth_present[k]), np.flatnonzero(est_present[k])
+        d = np.linalg.norm(truth[k, oids][:, None] - est[k, hids][None], axis=-1)
+        acc.update(oids.tolist(), hids.tolist(), np.where(d < threshold, d, np.nan))
+    summary = mm.metrics.create().compute(acc, metrics=["mota", "motp", "idf1", "num_switches"], name="x")
+    return summary.iloc[0]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_clear_mot_and_idf1_agree_with_motmetrics(seed):
+    rng = np.random.default_rng(seed)
+    frames, targets = 40, 5
+    truth = np.cumsum(rng.normal(0, 3, (frames, targets, 2)), axis=0) + rng.uniform(0, 60, (1, targets, 2))
+    est = truth + rng.normal(0, 4, truth.shape)
+    swap = rng.integers(10, 30)
+    est[swap:, [0, 1]] = est[swap:, [1, 0]]  # an identity swap
+    truth_present = rng.random((frames, targets)) > 0.1
+    est_present = rng.random((frames, targets)) > 0.15
+    ours = multi.clear_mot(truth, est, 8.0, truth_present, est_present)
+    theirs = motmetrics_summary(truth, est, 8.0, truth_present, est_present)
+    assert ours["mota"] == pytest.approx(theirs["mota"])
+    assert ours["motp"] == pytest.approx(theirs["motp"])
+    assert ours["switches"] == theirs["num_switches"]
+    assert multi.idf1(truth, est, 8.0, truth_present, est_present) == pytest.approx(theirs["idf1"])
