@@ -150,3 +150,20 @@ def test_export_writes_a_playable_mp4(tmp_path):
     while capture.read()[0]:
         frames += 1
     assert frames == 10
+
+
+def test_scene_writer_command(tmp_path):
+    import subprocess
+    import sys
+
+    from replication.paths import PROJECT_ROOT
+
+    command = [sys.executable, "-m", "replication.scenes", "experiment=demo_scene", f"out={tmp_path}", "format=images"]
+    result = subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert len(list((tmp_path / "synthetic_head" / "img").glob("*.jpg"))) == 150
+    assert len((tmp_path / "synthetic_head" / "groundtruth_rect.1.txt").read_text().splitlines()) == 150
+    refused = subprocess.run(
+        [sys.executable, "-m", "replication.scenes", "experiment=hspf_ungm"], cwd=PROJECT_ROOT, capture_output=True, text=True
+    )
+    assert refused.returncode == 2 and "no synthetic scene" in refused.stderr

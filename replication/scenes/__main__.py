@@ -1,6 +1,7 @@
-"""``python -m replication.scenes experiment=<name> [out=DIR] [format=mp4|images] [boxes=true]``.
+"""``python -m replication.scenes experiment=<name> [scene=<key>] [out=DIR] [format=mp4|images] [boxes=true]``.
 
-Writes the scene of an experiment (its ``scene:`` block) so it can be watched.
+Writes the synthetic scenes of an experiment (its ``scenes:`` block; real
+sequences are already on disk) so a person can watch them.
 """
 
 import sys
@@ -19,16 +20,19 @@ def main(argv: list[str]) -> None:
     options = dict(arg.split("=", 1) for arg in argv if "=" in arg)
     name = options.pop("experiment", None)
     if name not in experiment_names():
-        fail(f"name an experiment with a scene: experiment=<name>; known: {', '.join(experiment_names())}")
+        fail(f"name an experiment with scenes: experiment=<name>; known: {', '.join(experiment_names())}")
     out = Path(options.pop("out", str(resolve("reports") / "scenes")))
     video = options.pop("format", "mp4") == "mp4"
     boxes = options.pop("boxes", "false").lower() == "true"
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={name}"])
-    if "scene" not in cfg.experiment:
-        fail(f"experiment {name!r} has no scene")
-    sequence = build_sequence(OmegaConf.to_container(cfg.experiment.scene, resolve=True))
-    print(write_sequence(sequence, out, video=video, boxes=boxes))
+    scenes = OmegaConf.to_container(cfg.experiment.get("scenes", {}), resolve=True)
+    chosen = options.pop("scene", None)
+    synthetic = {k: v for k, v in scenes.items() if v.get("kind", "synthetic") == "synthetic" and chosen in (None, k)}
+    if not synthetic:
+        fail(f"experiment {name!r} has no synthetic scene{' ' + repr(chosen) if chosen else ''}")
+    for spec in synthetic.values():
+        print(write_sequence(build_sequence(spec), out, video=video, boxes=boxes))
 
 
 if __name__ == "__main__":
