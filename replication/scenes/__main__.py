@@ -26,7 +26,7 @@ def main(argv: list[str]) -> None:
     boxes = options.pop("boxes", "false").lower() == "true"
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={name}"])
-    scenes = OmegaConf.to_container(cfg.experiment.get("scenes", {}), resolve=True)
+    scenes = OmegaConf.to_container(cfg.experiment.scenes, resolve=True) if "scenes" in cfg.experiment else {}
     chosen = options.pop("scene", None)
     synthetic = {k: v for k, v in scenes.items() if v.get("kind", "synthetic") == "synthetic" and chosen in (None, k)}
     if not synthetic:
