@@ -7,11 +7,15 @@ the rest of its keys to it.
 """
 
 from replication.filters.bootstrap import bootstrap
+from replication.filters.ism import ism
 from replication.filters.point_mass import PointMassFilter
+from replication.filters.pso import pso
 
 FILTERS = {
     "bootstrap": bootstrap,
     "point_mass": PointMassFilter,
+    "pso": pso,
+    "ism": ism,
 }
 
-__all__ = ["FILTERS", "PointMassFilter", "bootstrap"]
+__all__ = ["FILTERS", "PointMassFilter", "bootstrap", "ism", "pso"]

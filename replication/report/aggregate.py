@@ -20,6 +20,19 @@ def mean_interval(values) -> tuple[float, float, float]:
     return mean, mean - half, mean + half
 
 
+def median_interval(values) -> tuple[float, float, float]:
+    """Median and a distribution-free 95% interval from order statistics (binomial ranks)."""
+    values = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
+    n = len(values)
+    if n == 0:
+        return np.nan, np.nan, np.nan
+    low_rank = int(stats.binom.ppf((1 - LEVEL) / 2, n, 0.5))
+    high_rank = int(stats.binom.isf((1 - LEVEL) / 2, n, 0.5))
+    if low_rank < 1 or high_rank >= n:
+        return float(np.median(values)), np.nan, np.nan
+    return float(np.median(values)), float(values[low_rank - 1]), float(values[high_rank])
+
+
 def comparison_interval(mean: float, sd: float, runs: int, paper_runs: int | None) -> tuple[float, float]:
     """The 95% interval a published mean over ``paper_runs`` runs should fall in if both estimate the same thing.
 
@@ -52,6 +65,8 @@ def summarise(records: pd.DataFrame, metric: str) -> pd.DataFrame:
                 "sd": float(values.std(ddof=1)) if len(values) > 1 else np.nan,
                 "variance": float(values.var(ddof=1)) if len(values) > 1 else np.nan,
                 "median": float(values.median()),
+                "median_low": median_interval(values)[1],
+                "median_high": median_interval(values)[2],
             }
         )
     return pd.DataFrame(rows)

@@ -51,10 +51,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             draw(records, figure_spec, experiment, out / file)
             figures.append({"title": figure_spec["title"], "file": file})
         records.drop(columns=["per_frame"], errors="ignore").to_csv(out / "runs.csv", index=False)
-    paper_tables = {str(t["paper_table"]) for t in spec.get("tables", []) if "paper_table" in t}
-    unmatched = pd.concat(
-        [cells(published, experiment["paper"], t) for t in sorted(paper_tables)] or [pd.DataFrame()]
-    )
+    paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
+    unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
     page = out / "index.html"
     page.write_text(
@@ -87,6 +85,10 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     return page
+
+
+def _as_list(value) -> list:
+    return [] if value is None else value if isinstance(value, list) else [value]
 
 
 def _versions() -> str:

@@ -18,34 +18,38 @@ def parse_condition(condition: str) -> dict[str, str]:
 def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
-    A method that does not sweep ``x`` (the point-mass reference, say) is drawn
+    ``by`` (a swept variable) splits the figure into one panel per value.  A
+    method that does not sweep ``x`` (the point-mass reference, say) is drawn
     as a horizontal band.
     """
     methods = experiment["methods"]
     summary = summarise(records, spec["metric"])
     conditions = summary["condition"].map(parse_condition)
     summary["x"] = conditions.map(lambda c: float(c.get(spec["x"], "nan")))
+    summary["panel"] = conditions.map(lambda c: c.get(spec.get("by"), ""))
     summary["series"] = [
-        " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k != spec["x"]])
+        " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k not in (spec["x"], spec.get("by"))])
         for m, c in zip(summary["method"], conditions)
     ]
-    fig, ax = plt.subplots(figsize=(6, 4))
-    swept = summary[summary["x"].notna()]
-    for series, group in swept.groupby("series", sort=False):
-        group = group.sort_values("x")
-        ax.plot(group["x"], group["mean"], marker="o", label=series)
-        ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
-    for _, row in summary[summary["x"].isna()].iterrows():
-        line = ax.axhline(row["mean"], linestyle="--", color="k", label=row["series"])
-        ax.axhspan(row["ci_low"], row["ci_high"], color=line.get_color(), alpha=0.1)
-    ax.set_xscale("log")
-    if spec.get("log_y"):
-        ax.set_yscale("log")
-    ax.set_xlabel(spec["x"])
-    ax.set_ylabel(f"{spec['metric']} (mean, 95% CI)")
-    ax.set_title(spec.get("title", ""))
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    panels = list(dict.fromkeys(summary["panel"]))
+    fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4), squeeze=False)
+    for ax, panel in zip(axes[0], panels):
+        rows = summary[summary["panel"] == panel]
+        for series, group in rows[rows["x"].notna()].groupby("series", sort=False):
+            group = group.sort_values("x")
+            ax.plot(group["x"], group["mean"], marker="o", label=series)
+            ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
+        for _, row in rows[rows["x"].isna()].iterrows():
+            line = ax.axhline(row["mean"], linestyle="--", color="k", label=row["series"])
+            ax.axhspan(row["ci_low"], row["ci_high"], color=line.get_color(), alpha=0.1)
+        ax.set_xscale("log")
+        if spec.get("log_y"):
+            ax.set_yscale("log")
+        ax.set_xlabel(spec["x"])
+        ax.set_ylabel(f"{spec['metric']} (mean, 95% CI)")
+        ax.set_title(f"{spec.get('by')}={panel}" if panel else spec.get("title", ""), fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -27,9 +27,10 @@ def load_published(path: str) -> pd.DataFrame:
     return table
 
 
-def cells(published: pd.DataFrame, paper: str, table: str, metric: str | None = None) -> pd.DataFrame:
-    """The published cells of one paper table (and one metric, if given)."""
-    chosen = (published["paper"] == paper) & (published["table"] == str(table))
+def cells(published: pd.DataFrame, paper: str, table, metric: str | None = None) -> pd.DataFrame:
+    """The published cells of one paper table or a list of tables (and one metric, if given)."""
+    tables = [str(t) for t in table] if isinstance(table, list) else [str(table)]
+    chosen = (published["paper"] == paper) & published["table"].isin(tables)
     if metric is not None:
         chosen &= published["metric"] == metric
     return published[chosen]

@@ -13,10 +13,16 @@ FLOOR_FILTER = "point_mass"
 def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
     """Return (table, index labels of the published cells it matched) for one ``report.tables`` entry."""
     metric, paper_metric = spec["metric"], spec.get("paper_metric", spec["metric"])
+    if "scale" in spec:  # e.g. a share of frames as the paper's percentage
+        records = records.assign(**{metric: records[metric] * spec["scale"]})
     ours = summarise(records, metric)
     ours = ours[ours["runs"] > 0].reset_index(drop=True)
+    if spec.get("statistic") == "median":  # timings: the median and its order-statistic interval
+        ours["mean"], ours["ci_low"], ours["ci_high"] = ours["median"], ours["median_low"], ours["median_high"]
     theirs = cells(published, experiment["paper"], spec["paper_table"], paper_metric).copy()
     theirs["condition"] = theirs["condition"].replace("", spec.get("paper_condition", ""))
+    # our condition -> the published cell it is compared with: a condition, or {experiment, condition}
+    match = {ours_: m if isinstance(m, dict) else {"condition": m} for ours_, m in spec.get("match", {}).items()}
     methods = experiment["methods"]
     paper_runs = spec.get("paper_runs")
     ours[["cmp_low", "cmp_high"]] = [
@@ -27,9 +33,15 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
         floors = ours[[methods[m]["filter"] == FLOOR_FILTER for m in ours["method"]]]
         floor_low = floors["cmp_low"].min() if len(floors) else None
         excess = excess_over_floor(records, [m for m in methods if methods[m]["filter"] == FLOOR_FILTER])
+    if match:  # a table of the conditions the paper's table covers
+        ours = ours[ours["condition"].isin(list(match))]
     rows, matched = [], set()
     for _, row in ours.iterrows():
-        hit = theirs[(theirs["method"] == row["method"]) & (theirs["condition"] == row["condition"])]
+        wanted = match.get(row["condition"], {"condition": row["condition"]})
+        chosen = (theirs["method"] == row["method"]) & (theirs["condition"] == wanted["condition"])
+        if "experiment" in wanted:
+            chosen &= theirs["experiment"] == wanted["experiment"]
+        hit = theirs[chosen]
         paper = float(hit["number"].iloc[0]) if len(hit) else np.nan
         matched.update(hit.index)
         entry = {

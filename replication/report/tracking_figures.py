@@ -44,11 +44,15 @@ def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
     return group.sort_values("repetition").groupby("method", sort=False).head(1)
 
 
+def _scene_name(experiment: dict, condition: str) -> str:
+    scene = [p.split("=", 1)[1] for p in condition.split(";") if p.startswith("scene=")]
+    return scene[0] if scene else experiment["model"]["scene"]
+
+
 def _sequence(experiment: dict, condition_records: pd.DataFrame):
-    scenes = experiment["scenes"]
-    scene = [p.split("=", 1)[1] for p in condition_records["condition"].iloc[0].split(";") if p.startswith("scene=")]
-    name = scene[0] if scene else experiment["model"]["scene"]
-    return cached_sequence(scenes[name]), experiment["model"].get("target", 0)
+    """The sequence of a condition's runs and the targets they track."""
+    name = _scene_name(experiment, condition_records["condition"].iloc[0])
+    return cached_sequence(experiment["scenes"][name]), condition_records["per_frame"].iloc[0]["targets"]
 
 
 def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
@@ -56,14 +60,15 @@ def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Pa
     groups = _by_condition(records)
     fig, axes = plt.subplots(len(groups), 2, figsize=(9, 2.6 * len(groups)), squeeze=False)
     for row, (condition, group) in zip(axes, groups):
-        sequence, target = _sequence(experiment, group)
-        truth = sequence.truth[:, target]
-        centre = truth[:, :2] + truth[:, 2:] / 2
+        sequence, chosen = _sequence(experiment, group)
+        truth = sequence.truth[:, chosen]
+        centre = truth[..., :2] + truth[..., 2:] / 2
         for axis, ax in enumerate(row):
-            ax.plot(centre[:, axis], "k-", lw=2, label="truth")
-            for _, run in _first_runs(group).iterrows():
+            ax.plot(centre[..., axis], "k-", lw=2, label="truth")
+            for index, (_, run) in enumerate(_first_runs(group).iterrows()):
                 boxes = np.array(run["per_frame"]["box"])
-                ax.plot(boxes[:, axis] + boxes[:, axis + 2] / 2, label=_label(experiment, run["method"]))
+                lines = ax.plot(boxes[..., axis] + boxes[..., axis + 2] / 2, color=f"C{index}", lw=1)
+                lines[0].set_label(_label(experiment, run["method"]))
             ax.set_title(f"{condition}: centre {'xy'[axis]}", fontsize=9)
             ax.grid(True, alpha=0.3)
         row[0].legend(fontsize=7)
@@ -76,31 +81,56 @@ def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Pa
 COLOURS = [(0, 0, 255), (255, 0, 0), (0, 200, 255), (255, 0, 255), (255, 255, 0)]
 
 
+def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
+    """Snapshot frames (0-based): one list for every scene, or a list per scene name."""
+    frames = spec["frames"][scene] if isinstance(spec["frames"], dict) else spec["frames"]
+    return [k for k in frames if k < n_frames]
+
+
 def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """A grid: one row per condition and method, one column per frame; truth green, estimate coloured."""
-    tiles = []
+    """Snapshot grids, one block per condition; truth green, each method's first run in its colour.
+
+    ``rows: frames`` puts frames down and methods across (the papers' layout);
+    otherwise methods down and frames across.
+    """
+    blocks = []
     for condition, group in _by_condition(records):
-        sequence, target = _sequence(experiment, group)
-        frames = [k for k in spec["frames"] if k < sequence.n_frames]
-        for index, (_, run) in enumerate(_first_runs(group).iterrows()):
-            boxes = np.array(run["per_frame"]["box"])
-            row = []
-            for k in frames:
-                image = sequence.frame(k).copy()
-                for box, colour in ((sequence.truth[k, target], (0, 200, 0)), (boxes[k], COLOURS[index % 5])):
-                    x, y, w, h = box
-                    cv2.rectangle(image, (int(x), int(y)), (int(x + w), int(y + h)), colour, 1)
-                row.append(image)
-            tiles.append((f"{condition} / {_label(experiment, run['method'])}", frames, row))
-    fig, axes = plt.subplots(len(tiles), max(len(t[2]) for t in tiles), figsize=(2.2 * 5, 1.9 * len(tiles)), squeeze=False)
-    for ax_row, (title, frames, images) in zip(axes, tiles):
-        for ax in ax_row:
-            ax.axis("off")
-        for ax, k, image in zip(ax_row, frames, images):
-            ax.imshow(cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
-            ax.set_title(f"#{k + 1}", fontsize=8)
-        ax_row[0].text(0, -0.25, title, transform=ax_row[0].transAxes, fontsize=7, va="top")
+        sequence, chosen = _sequence(experiment, group)
+        frames = _frames(spec, _scene_name(experiment, condition), sequence.n_frames)
+        runs = list(_first_runs(group).iterrows())
+        grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k, i) for i, (_, run) in enumerate(runs)]
+                for k in frames]
+        labels = [_label(experiment, run["method"]) for _, run in runs]
+        if spec.get("rows") != "frames":
+            grid = [list(column) for column in zip(*grid)]
+        blocks.append((condition, frames, labels, grid))
+    n_rows = sum(len(grid) for *_, grid in blocks)
+    n_cols = max(len(grid[0]) for *_, grid in blocks if grid)
+    fig, axes = plt.subplots(n_rows, n_cols, figsize=(2.3 * n_cols, 1.9 * n_rows), squeeze=False)
+    for ax in axes.ravel():
+        ax.axis("off")
+    row = 0
+    for condition, frames, labels, grid in blocks:
+        down, across = (frames, labels) if spec.get("rows") == "frames" else (labels, frames)
+        for r, images in enumerate(grid):
+            for c, image in enumerate(images):
+                ax = axes[row + r, c]
+                ax.imshow(cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
+                title = across[c] if isinstance(across[c], str) else f"#{across[c] + 1}"
+                side = down[r] if isinstance(down[r], str) else f"#{down[r] + 1}"
+                ax.set_title(f"{condition}: {title}" if r == 0 else "", fontsize=6)
+                ax.text(-0.02, 0.5, side, transform=ax.transAxes, fontsize=6, rotation=90, ha="right", va="center")
+        row += len(grid)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, index: int) -> np.ndarray:
+    image = sequence.frame(k).copy()
+    for m, target in enumerate(chosen):
+        for box, colour in ((sequence.truth[k, target], (0, 200, 0)), (boxes[k, m], COLOURS[index % len(COLOURS)])):
+            x, y, w, h = box
+            cv2.rectangle(image, (int(x), int(y)), (int(x + w), int(y + h)), colour, 1)
+    return image

@@ -1,8 +1,9 @@
 """Validate an experiment config and expand it into independent runs.
 
-A list given directly under ``model`` or directly under a method is a sweep:
-the runs are the product method x sweep values x repetition.  Nested values
-(a motion, an observation model, a scene) are parameters, lists included.  Everything is checked
+The ``sweep:`` block of ``model`` or of a method lists the values a parameter
+takes (``sweep: {n_particles: [500, 200, 100]}``): the runs are the product
+method x swept values x repetition.  Everything else is a parameter, lists
+included (a velocity clamp, histogram bins).  Everything is checked
 before any work starts, and errors are one line that names the bad key.
 """
 
@@ -72,8 +73,15 @@ def _label(name: str, value: Any) -> str:
     return f"{SHORT_NAMES.get(name, name)}={value}"
 
 
-def _sweeps(params: dict[str, Any], on_model: bool) -> list[tuple[bool, str, list]]:
-    return [(on_model, k, list(v)) for k, v in params.items() if isinstance(v, list)]
+def _sweeps(params: dict[str, Any], on_model: bool, where: str) -> list[tuple[bool, str, list]]:
+    """The (on_model, name, values) of a block's ``sweep:``, removed from ``params``."""
+    sweep = params.pop("sweep", None) or {}
+    if not isinstance(sweep, dict):
+        raise ConfigError(f"{where}.sweep must map parameter names to lists of values")
+    for name, values in sweep.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"{where}.sweep.{name} must be a non-empty list of values, got {values!r}")
+    return [(on_model, name, list(values)) for name, values in sweep.items()]
 
 
 def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
@@ -110,6 +118,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
         raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
     task = TASKS[exp.task]
     model = OmegaConf.to_container(exp.model, resolve=True)
+    model_sweeps = _sweeps(model, True, "model")
     scenes = OmegaConf.to_container(exp.scenes, resolve=True) if "scenes" in exp else {}
     methods = OmegaConf.to_container(exp.methods, resolve=True)
     if not methods:
@@ -119,7 +128,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
         if params.get("filter") not in FILTERS:
             what = f"unknown filter {params['filter']!r}" if "filter" in params else "no 'filter:' key"
             raise ConfigError(f"method {method!r}: {what}; known filters: {', '.join(sorted(FILTERS))}")
-        sweeps = _sweeps(model, True) + _sweeps(params, False)
+        sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
         for values in itertools.product(*(values for _, _, values in sweeps)):
             run_model, run_params = dict(model), dict(params)
             labels, data_labels = [], []

@@ -22,8 +22,8 @@ def build_sequence(spec: dict):
         present, missing = find_otb([spec["name"]], root)
         if missing:
             raise SequenceMissing(missing[0])
-        return OTBSequence(spec["name"], root, spec.get("first", 0), spec.get("last"))
-    scene = {k: v for k, v in spec.items() if k not in ("kind", "name", "stand_in")}
+        return OTBSequence(spec["name"], root, spec.get("first", 0), spec.get("last"), spec.get("stand_in"))
+    scene = {k: v for k, v in spec.items() if k not in ("kind", "name", "stand_in", "track")}
     return SyntheticScene(scene, name=spec.get("name", "synthetic"), stand_in=spec.get("stand_in"))
 
 

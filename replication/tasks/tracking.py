@@ -21,6 +21,13 @@ from replication.vision.histogram import ColourHistogram
 OBSERVATIONS = ("colour",)
 
 
+def targets(model: dict) -> list[int]:
+    """The targets a run tracks, each with its own filter: the model's ``targets``, else the
+    scene's ``track`` list, else ``target`` (default 0)."""
+    default = model.get("scene_spec", {}).get("track", [model.get("target", 0)])
+    return list(model.get("targets", default))
+
+
 def check(model: dict, method: dict) -> None:
     if "scene_spec" not in model:
         raise ValueError("a tracking experiment needs model.scene naming one of experiment.scenes")
@@ -28,9 +35,9 @@ def check(model: dict, method: dict) -> None:
     if observation.get("kind", "colour") not in OBSERVATIONS:
         raise ValueError(f"unknown observation {observation.get('kind')!r}; choose one of {OBSERVATIONS}")
     sequence = cached_sequence(model["scene_spec"])
-    target = model.get("target", 0)
-    if not 0 <= target < sequence.truth.shape[1]:
-        raise ValueError(f"target {target} not in the scene's {sequence.truth.shape[1]} targets")
+    for target in targets(model):
+        if not 0 <= target < sequence.truth.shape[1]:
+            raise ValueError(f"target {target} not in the scene's {sequence.truth.shape[1]} targets")
     ColourHistogram(**_histogram_args(observation, (8, 8), None))
     BoxModel(np.zeros(4), None, **model.get("motion", {}))
 
@@ -46,11 +53,11 @@ def _histogram_args(observation: dict, box_size, rng) -> dict:
     }
 
 
-def build_model(run: Run, sequence) -> BoxModel:
+def build_model(run: Run, sequence, target: int) -> BoxModel:
     observation = run.model.get("observation", {})
-    x, y, w, h = sequence.truth[0, run.model.get("target", 0)]
+    x, y, w, h = sequence.truth[0, target]
     initial = np.array([x + w / 2, y + h / 2, w, h])
-    histogram = ColourHistogram(**_histogram_args(observation, (w, h), run.rng("pattern")))
+    histogram = ColourHistogram(**_histogram_args(observation, (w, h), run.rng(f"pattern{target}")))
     likelihood = ColourLikelihood.from_frame(sequence.frame(0), initial, histogram, observation.get("sigma", 0.1))
     return BoxModel(initial, likelihood, **run.model.get("motion", {}))
 
@@ -69,37 +76,49 @@ class _TimedFrames:
             yield frame
 
 
-def run(run: Run) -> dict:
-    sequence = cached_sequence(run.model["scene_spec"])
-    truth = sequence.truth[:, run.model.get("target", 0)]
-    model = build_model(run, sequence)
+def track(run: Run, sequence, target: int) -> tuple[np.ndarray, dict, float]:
+    """Filter one target with its own filter: estimated boxes (T, 4), diagnostics, seconds of filtering."""
+    model = build_model(run, sequence, target)
     method = build_filter(run.method, run.method_params)
     frames = _TimedFrames(sequence)
     started = time.perf_counter()
-    output = method.run(model, frames, run.rng("filter"))
+    output = method.run(model, frames, run.rng(f"filter{target}"))
     elapsed = time.perf_counter() - started - frames.seconds
-    estimates = np.vstack([truth[:1], BoxModel.boxes(output.means)])
-    errors, overlaps = tm.centre_error(estimates, truth), tm.iou(estimates, truth)
+    estimates = np.vstack([sequence.truth[:1, target], BoxModel.boxes(output.means)])
+    return estimates, {**filter_diagnostics(output), "ess": output.ess}, elapsed
+
+
+def run(run: Run) -> dict:
+    """Track every target of the run; numbers are averaged over targets, 'tracked to the end' needs all."""
+    sequence = cached_sequence(run.model["scene_spec"])
+    chosen = targets(run.model)
+    results = [track(run, sequence, target) for target in chosen]
+    estimates = np.stack([r[0] for r in results], axis=1)  # (T, M, 4)
+    truth = sequence.truth[:, chosen]
+    errors, overlaps = tm.centre_error(estimates, truth), tm.iou(estimates, truth)  # (T, M)
     deviation = tm.deviation(estimates, truth)
     scored = slice(1, None)  # frame 0 is given
     record = {
         "frames": sequence.n_frames,
         "mean_cle": float(errors[scored].mean()),
-        "precision20": tm.precision_at(errors[scored]),
-        "success_auc": tm.success_auc(overlaps[scored]),
-        "ms_per_frame": 1000.0 * elapsed / (sequence.n_frames - 1),
-        **filter_diagnostics(output),
+        "precision20": float(np.mean([tm.precision_at(e) for e in errors[scored].T])),
+        "success_auc": float(np.mean([tm.success_auc(o) for o in overlaps[scored].T])),
+        "ms_per_frame": 1000.0 * sum(r[2] for r in results) / (sequence.n_frames - 1),
+        "mean_ess": float(np.mean([r[1]["mean_ess"] for r in results])),
+        "resample_count": float(np.mean([r[1]["resample_count"] for r in results])),
+        "degenerate_steps": int(sum(r[1]["degenerate_steps"] for r in results)),
     }
     for rule in tm.CORRECT_RULES:
         correct = tm.correct_frames(errors[scored], overlaps[scored], rule)
         record[f"correct_frames[{rule}]"] = float(correct.mean())
-        record[f"tracked_to_end[{rule}]"] = float(tm.tracked_to_end(correct))
+        record[f"tracked_to_end[{rule}]"] = float(all(tm.tracked_to_end(c) for c in correct.T))
     record["per_frame"] = {
-        "cle": np.round(errors, 3).tolist(),
-        "iou": np.round(overlaps, 4).tolist(),
-        "dx": np.round(deviation[:, 0], 3).tolist(),
-        "dy": np.round(deviation[:, 1], 3).tolist(),
+        "cle": np.round(errors.mean(axis=1), 3).tolist(),
+        "iou": np.round(overlaps.mean(axis=1), 4).tolist(),
+        "dx": np.round(deviation[..., 0].mean(axis=1), 3).tolist(),
+        "dy": np.round(deviation[..., 1].mean(axis=1), 3).tolist(),
         "box": np.round(estimates, 2).tolist(),
-        "ess": [None] + np.round(output.ess, 2).tolist(),
+        "targets": chosen,
+        "ess": [None] + np.round(np.mean([r[1]["ess"] for r in results], axis=0), 2).tolist(),
     }
     return record

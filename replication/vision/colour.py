@@ -28,9 +28,10 @@ class ColourLikelihood:
         return hsv_bin_image(frame, self.histogram.bins)
 
     def similarity(self, boxes: np.ndarray, bin_image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """rho of each box against the reference, and whether the box had any pixel in the image."""
+        """rho of each box against the reference, and whether the box is a box with a pixel in the image."""
         histograms = self.histogram.of_boxes(bin_image, boxes)
-        return bhattacharyya(histograms, self.reference), histograms.sum(axis=1) > 0
+        valid = (histograms.sum(axis=1) > 0) & (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
+        return bhattacharyya(histograms, self.reference), valid
 
     def log_likelihood(self, boxes: np.ndarray, bin_image: np.ndarray) -> np.ndarray:
         rho, valid = self.similarity(boxes, bin_image)
