@@ -34,7 +34,7 @@ class BoxModel:
     period: float = 1.0  # T of gps_qmcpf eq (14)
     initial_sd: tuple[float, float, float, float] = (2.0, 2.0, 0.5, 0.5)
     min_size: float = 2.0
-    _cache: dict = field(default_factory=dict, repr=False)
+    cache: dict = field(default_factory=dict, repr=False)  # frame features; shared by a run's targets
 
     def __post_init__(self):
         if self.kind not in MOTIONS:
@@ -65,10 +65,11 @@ class BoxModel:
         return moved
 
     def log_likelihood(self, particles: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
-        """N log-likelihoods; the frame's features are computed once per frame and reused by moves."""
-        if self._cache.get("t") != t:
-            self._cache = {"t": t, "prepared": self.likelihood.prepare(frame)}
-        return self.likelihood.log_likelihood(particles[:, :4], self._cache["prepared"])
+        """N log-likelihoods; the frame's features are computed once per frame and reused by moves
+        and by the other targets' models that share ``cache``."""
+        if self.cache.get("t") != t:
+            self.cache.update(t=t, prepared=self.likelihood.prepare(frame))
+        return self.likelihood.log_likelihood(particles[:, :4], self.cache["prepared"])
 
     @staticmethod
     def boxes(states: np.ndarray) -> np.ndarray:

@@ -100,6 +100,25 @@ class FilterOutput:
 
 
 @dataclass
+class FilterState:
+    """A filter between steps: its particles, log-weights, random stream and what it has recorded."""
+
+    model: StateSpaceModel
+    rng: np.random.Generator
+    particles: np.ndarray
+    log_weights: np.ndarray
+    t: int = 0
+    log_evidence: float = 0.0
+    records: dict = field(default_factory=lambda: {k: [] for k in ("means", "variances", "ess", "resampled", "degenerate")})
+
+    def output(self) -> FilterOutput:
+        arrays = {k: np.asarray(v) for k, v in self.records.items()}
+        arrays["resampled"] = arrays["resampled"].astype(bool)
+        arrays["degenerate"] = arrays["degenerate"].astype(bool)
+        return FilterOutput(**arrays, log_evidence=self.log_evidence)
+
+
+@dataclass
 class ParticleFilter:
     """A particle filter with N particles, a proposal, an optional move and a resampling policy."""
 
@@ -114,49 +133,51 @@ class ParticleFilter:
         self.n_particles = int(self.n_particles)
 
     def run(self, model: StateSpaceModel, observations, rng: np.random.Generator) -> FilterOutput:
-        """Filter ``observations`` (z_1 .. z_T) and return the per-step estimates.
+        """Filter ``observations`` (z_1 .. z_T) and return the per-step estimates."""
+        state = self.start(model, rng)
+        for z in observations:
+            self.step(state, z)
+        return state.output()
+
+    def start(self, model: StateSpaceModel, rng: np.random.Generator) -> FilterState:
+        """Particles from the prior at t = 0, equally weighted; filters can then be stepped in lockstep."""
+        n = self.n_particles
+        return FilterState(model, rng, model.sample_initial(n, rng), np.full(n, -np.log(n)))
+
+    def step(self, state: FilterState, z) -> None:
+        """Propose, move, weight, estimate and maybe resample for the next observation z_t.
 
         A step where every log-weight is -inf (no particle explains z_t) is
         recovered by keeping the predicted weights (those before the
         likelihood), as if z_t had carried no information; it is flagged in
         ``FilterOutput.degenerate`` (log_evidence then gets the predicted mass only).
         """
-        n = self.n_particles
-        particles = model.sample_initial(n, rng)
-        log_weights = np.full(n, -np.log(n))
-        means, variances, ess_values, resampled, degenerate = [], [], [], [], []
-        log_evidence = 0.0
-        for t, z in enumerate(observations, start=1):
-            particles, log_weights = self.proposal(model, particles, log_weights, t, rng)
-            if self.move is not None:
-                particles, correction = self.move(
-                    particles, lambda x, z=z, t=t: model.log_likelihood(x, z, t), rng
-                )
-                log_weights = log_weights + correction
-            predicted = log_weights
-            log_weights = log_weights + model.log_likelihood(particles, z, t)
-            try:
-                weights, log_total = normalise(log_weights)
-                degenerate.append(False)
-            except DegenerateWeightsError:
-                log_weights = predicted
-                weights, log_total = normalise(predicted)
-                degenerate.append(True)
-            log_evidence += log_total
-            log_weights = log_weights - log_total
-            means.append(weighted_mean(particles, weights))
-            variances.append(weighted_variance(particles, weights))
-            ess_values.append(ess(weights))
-            do_resample = self.resampling.wants(ess_values[-1], n)
-            if do_resample:
-                particles = particles[RESAMPLERS[self.resampling.scheme](weights, rng)]
-                log_weights = np.full(n, -np.log(n))
-            resampled.append(do_resample)
-        return FilterOutput(
-            means=np.asarray(means),
-            variances=np.asarray(variances),
-            ess=np.asarray(ess_values),
-            resampled=np.asarray(resampled, dtype=bool),
-            degenerate=np.asarray(degenerate, dtype=bool),
-            log_evidence=log_evidence,
-        )
+        model, rng, n = state.model, state.rng, self.n_particles
+        state.t += 1
+        t = state.t
+        particles, log_weights = self.proposal(model, state.particles, state.log_weights, t, rng)
+        if self.move is not None:
+            particles, correction = self.move(particles, lambda x: model.log_likelihood(x, z, t), rng)
+            log_weights = log_weights + correction
+        predicted = log_weights
+        log_weights = log_weights + model.log_likelihood(particles, z, t)
+        try:
+            weights, log_total = normalise(log_weights)
+            degenerate = False
+        except DegenerateWeightsError:
+            log_weights = predicted
+            weights, log_total = normalise(predicted)
+            degenerate = True
+        state.log_evidence += log_total
+        log_weights = log_weights - log_total
+        records = state.records
+        records["means"].append(weighted_mean(particles, weights))
+        records["variances"].append(weighted_variance(particles, weights))
+        records["ess"].append(ess(weights))
+        records["degenerate"].append(degenerate)
+        do_resample = self.resampling.wants(records["ess"][-1], n)
+        if do_resample:
+            particles = particles[RESAMPLERS[self.resampling.scheme](weights, rng)]
+            log_weights = np.full(n, -np.log(n))
+        records["resampled"].append(do_resample)
+        state.particles, state.log_weights = particles, log_weights

@@ -90,6 +90,7 @@ class ColourHistogram:
             raise ValueError(f"at most 65535 bins in all, got {self.n_bins}")
         self.points, self.weights = sample_pattern(self.kernel, tuple(self.grid), self.samples, self.rng)
         self._u, self._v = (self.points[:, i].astype(np.float32) for i in (0, 1))
+        self._tiles: dict[int, np.ndarray] = {}
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height.
@@ -101,6 +102,12 @@ class ColourHistogram:
         """
         boxes = np.atleast_2d(np.asarray(boxes, dtype=float))
         return np.vstack([self._block(bin_image, boxes[i : i + BLOCK]) for i in range(0, len(boxes), BLOCK)])
+
+    def _tiled(self, n: int) -> np.ndarray:
+        """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
+        if n not in self._tiles:
+            self._tiles[n] = np.tile(self.weights, n)
+        return self._tiles[n]
 
     def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         n, spare = len(boxes), self.n_bins
@@ -118,7 +125,7 @@ class ColourHistogram:
             u2, v2 = self.points[None, :, 0] ** 2, self.points[None, :, 1] ** 2
             weights = (1.0 - (u2 * share + v2 * (1.0 - share))).ravel()
         else:
-            weights = np.tile(self.weights, n)
+            weights = self._tiled(n)
         counts = np.bincount(index.ravel(), weights=weights, minlength=n * (spare + 1))
         histograms = counts.reshape(n, spare + 1)[:, :spare]
         totals = histograms.sum(axis=1, keepdims=True)
