@@ -64,6 +64,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             n_records=len(records),
             n_runs=len(runs),
             tables=tables,
+            scenes=_scenes(experiment),
             figures=figures,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)
@@ -85,6 +86,20 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     return page
+
+
+def _scenes(experiment: dict) -> list[dict]:
+    """What each scene of a tracking experiment is: real video, or a synthetic stand-in and for what."""
+    rows = []
+    for name, spec in experiment.get("scenes", {}).items():
+        if spec.get("kind", "synthetic") == "otb":
+            frames = f"frames {spec.get('first', 0) + 1}-{spec['last']}" if spec.get("last") else "all frames"
+            rows.append({"name": name, "kind": "real video (OTB)", "what": f"OTB sequence {spec['name']}, {frames}"})
+        else:
+            size = "x".join(str(v) for v in spec.get("size", []))
+            what = spec.get("stand_in") or "synthetic scene"
+            rows.append({"name": name, "kind": "synthetic stand-in", "what": f"{what} ({size}, {spec.get('frames')} frames)"})
+    return rows
 
 
 def _as_list(value) -> list:

@@ -40,7 +40,7 @@ def check(model: dict, method: dict) -> None:
     for target in targets(model):
         if not 0 <= target < sequence.truth.shape[1]:
             raise ValueError(f"target {target} not in the scene's {sequence.truth.shape[1]} targets")
-    ColourHistogram(**_histogram_args(observation, (8, 8), None))
+    ColourHistogram(**_histogram_args(observation, (8, 8), np.random.default_rng(0)))  # validation only
     BoxModel(np.zeros(4), None, **model.get("motion", {}))
 
 
