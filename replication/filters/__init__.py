@@ -3,9 +3,11 @@
 loop of :mod:`replication.smc.loop` with their own proposal or move.
 
 A method in an experiment config names its builder with ``filter:`` and passes
-the rest of its keys to it.
+the rest of its keys to it.  A filter with ``joint = True`` (BIS-PF) tracks all
+targets of a run together: ``start(models, rng)`` and ``step(state, z)``.
 """
 
+from replication.filters.bis import BISPF
 from replication.filters.bootstrap import bootstrap
 from replication.filters.ism import ism
 from replication.filters.point_mass import PointMassFilter
@@ -16,6 +18,7 @@ FILTERS = {
     "point_mass": PointMassFilter,
     "pso": pso,
     "ism": ism,
+    "bis": BISPF,
 }
 
-__all__ = ["FILTERS", "PointMassFilter", "bootstrap", "ism", "pso"]
+__all__ = ["BISPF", "FILTERS", "PointMassFilter", "bootstrap", "ism", "pso"]

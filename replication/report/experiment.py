@@ -15,15 +15,15 @@ from replication.paths import resolve
 from replication.report.figures import draw
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
-from replication.report.tables import build_summary_table, build_table, format_table
+from replication.report.tables import build_rating_table, build_summary_table, build_table, format_table
 from replication.report.verdict import RULES
-from replication.runner.config import Run
+from replication.runner.config import Run, at_scale
 from replication.runner.store import Store
 
 
 def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> Path:
     """Write ``<reports>/<experiment>/`` from the stored records of ``runs``; return the page's path."""
-    experiment = OmegaConf.to_container(cfg.experiment, resolve=True)
+    experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale)
     out = resolve(cfg.reports) / experiment["name"]
     out.mkdir(parents=True, exist_ok=True)
     records = store.load(runs)
@@ -38,12 +38,13 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                 table.to_csv(out / csv, index=False)
                 tables.append({"title": table_spec["title"], "html": html_table(table), "csv": csv})
                 continue
-            table, hits = build_table(records, table_spec, experiment, published)
+            build = build_rating_table if table_spec.get("kind") == "rating" else build_table
+            table, hits = build(records, table_spec, experiment, published)
             matched |= hits
             verdicts.update(v.split(" (")[0] for v in table["verdict"])
             csv = f"{table_spec['name']}.csv"
             table.to_csv(out / csv, index=False)
-            html = html_table(format_table(table))
+            html = html_table(table if table_spec.get("kind") == "rating" else format_table(table))
             (out / f"{table_spec['name']}.html").write_text(html)
             tables.append({"title": table_spec["title"], "html": html, "csv": csv})
         for figure_spec in spec.get("figures", []):

@@ -38,7 +38,9 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
     rows, matched = [], set()
     for _, row in ours.iterrows():
         wanted = match.get(row["condition"], {"condition": row["condition"]})
-        chosen = (theirs["method"] == row["method"]) & (theirs["condition"] == wanted["condition"])
+        chosen = theirs["method"] == row["method"]
+        if "condition" in wanted:
+            chosen &= theirs["condition"] == wanted["condition"]
         if "experiment" in wanted:
             chosen &= theirs["experiment"] == wanted["experiment"]
         hit = theirs[chosen]
@@ -61,6 +63,38 @@ def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: 
         entry["paper"] = paper
         entry["verdict"] = verdict(paper, row["mean"], row["cmp_low"], row["cmp_high"], paper_metric, floor_low)
         rows.append(entry)
+    return pd.DataFrame(rows), matched
+
+
+def stability(failures: int, runs: int) -> str:
+    """bis_pf's rating over (nominally 10) runs: good = no failure, medium = 2 or more, poor = 5 or more."""
+    scaled = failures * 10 / runs  # the rule is stated per 10 runs
+    return "poor" if scaled >= 5 else "medium" if scaled >= 2 else "good"
+
+
+def build_rating_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
+    """Failed runs and the paper's stability rating per method and condition (bis_pf Table 3)."""
+    theirs = cells(published, experiment["paper"], spec["paper_table"], spec["paper_metric"])
+    match = spec.get("match", {})
+    rows, matched = [], set()
+    for (method, condition), group in records.groupby(["method", "condition"], sort=False):
+        failures, runs = int(group[spec["metric"]].sum()), len(group)
+        ours = stability(failures, runs)
+        wanted = match.get(condition, {})
+        hit = theirs[(theirs["method"] == method) & (theirs["experiment"] == wanted.get("experiment", condition))]
+        matched.update(hit.index)
+        paper = hit["value"].iloc[0] if len(hit) else ""
+        rows.append(
+            {
+                "method": experiment["methods"][method].get("label", method),
+                "condition": condition or "-",
+                "runs": runs,
+                "failed runs": failures,
+                "ours": ours,
+                "paper": paper,
+                "verdict": "reference" if not paper else "agrees" if paper == ours else "differs",
+            }
+        )
     return pd.DataFrame(rows), matched
 
 

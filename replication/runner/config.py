@@ -1,5 +1,7 @@
 """Validate an experiment config and expand it into independent runs.
 
+A value written ``{paper: a, quick: b}`` anywhere in the model, scenes or
+methods takes the entry of the current scale (e.g. a scene's frame count).
 The ``sweep:`` block of ``model`` or of a method lists the values a parameter
 takes (``sweep: {n_particles: [500, 200, 100]}``): the runs are the product
 method x swept values x repetition.  Everything else is a parameter, lists
@@ -94,6 +96,17 @@ def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
 
 
+def at_scale(value: Any, scale: str) -> Any:
+    """Replace every ``{paper: a, quick: b}`` inside ``value`` by the entry for ``scale``."""
+    if isinstance(value, dict):
+        if set(value) == set(SCALES):
+            return at_scale(value[scale], scale)
+        return {k: at_scale(v, scale) for k, v in value.items()}
+    if isinstance(value, list):
+        return [at_scale(v, scale) for v in value]
+    return value
+
+
 def n_runs(cfg: DictConfig) -> int:
     scale = cfg.scale
     if scale not in SCALES:
@@ -117,10 +130,10 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     if exp.get("task") not in TASKS:
         raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
     task = TASKS[exp.task]
-    model = OmegaConf.to_container(exp.model, resolve=True)
+    model = at_scale(OmegaConf.to_container(exp.model, resolve=True), cfg.scale)
     model_sweeps = _sweeps(model, True, "model")
-    scenes = OmegaConf.to_container(exp.scenes, resolve=True) if "scenes" in exp else {}
-    methods = OmegaConf.to_container(exp.methods, resolve=True)
+    scenes = at_scale(OmegaConf.to_container(exp.scenes, resolve=True), cfg.scale) if "scenes" in exp else {}
+    methods = at_scale(OmegaConf.to_container(exp.methods, resolve=True), cfg.scale)
     if not methods:
         raise ConfigError("experiment.methods is empty")
     runs, skipped = [], [] if skipped is None else skipped

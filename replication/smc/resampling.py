@@ -24,10 +24,9 @@ def _inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
 
 
-def multinomial(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """N i.i.d. draws from the categorical distribution W (Gordon et al., 1993)."""
-    n = len(weights)
-    return _inverse_cdf(weights, rng.random(n))
+def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None = None) -> np.ndarray:
+    """i.i.d. draws (N, or ``size``) from the categorical distribution W (Gordon et al., 1993)."""
+    return _inverse_cdf(weights, rng.random(len(weights) if size is None else size))
 
 
 def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
