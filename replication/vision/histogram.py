@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 
 KERNELS = ("epanechnikov", "diagonal", "uniform")
-BLOCK = 64  # boxes per bincount: keeps the gathered indices and weights in cache
+BLOCK_SAMPLES = 100_000  # sample points per bincount: big enough to amortise the calls, small enough for cache
 
 
 _SUM_CHANNELS = np.ones((1, 3), np.float32)
@@ -98,10 +98,14 @@ class ColourHistogram:
         One ``cv2.remap`` (nearest neighbour) gathers the bin indices of a block
         of boxes; points outside the image read a spare bin B that is dropped;
         one ``np.bincount`` over box-offset indices gives the block's
-        histograms.  Blocks of ``BLOCK`` boxes keep the work in cache.
+        histograms.  Blocks of about ``BLOCK_SAMPLES`` sample points keep the
+        work in cache.
         """
         boxes = np.atleast_2d(np.asarray(boxes, dtype=float))
-        return np.vstack([self._block(bin_image, boxes[i : i + BLOCK]) for i in range(0, len(boxes), BLOCK)])
+        block = max(1, BLOCK_SAMPLES // len(self.weights))
+        if len(boxes) <= block:
+            return self._block(bin_image, boxes)
+        return np.vstack([self._block(bin_image, boxes[i : i + block]) for i in range(0, len(boxes), block)])
 
     def _tiled(self, n: int) -> np.ndarray:
         """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
