@@ -21,6 +21,9 @@ A scene is declared as a dict (from Hydra config), for example::
       - {shape: box, size: [40, 120], colour: [20, 20, 20], depth: 0,
          motion: {kind: scripted, keyframes: [[0, 160, 120]]}}
 
+A target with ``copies: n`` stands for n targets with depths depth, depth + 1,
+... (the bis_pf balls); a random-walk copy draws its own start and velocity.
+
 Motion kinds: ``scripted`` (linear between keyframes [frame, cx, cy]),
 ``velocity`` (piecewise constant velocity: start [cx, cy], segments
 [[frame, vx, vy], ...]; a sudden speed change is a new segment) and
@@ -182,6 +185,8 @@ class SyntheticScene:
     """A rendered scene: ``frame(k)``, ``truth`` (T, M, 4), ``visibility`` (T, M)."""
 
     def __init__(self, spec: dict, name: str = "synthetic", stand_in: str | None = None):
+        targets = [dict(t, depth=t.get("depth", 0) + i) for t in spec.get("targets", []) for i in range(t.get("copies", 1))]
+        spec = {**spec, "targets": targets}
         self.spec, self.name, self.stand_in = spec, name, stand_in
         _require("size" in spec and "frames" in spec, "a scene needs size: [width, height] and frames:")
         self.size = tuple(int(v) for v in spec["size"])

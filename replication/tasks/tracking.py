@@ -24,11 +24,11 @@ from replication.vision.histogram import ColourHistogram
 OBSERVATIONS = ("colour",)
 
 
-def targets(model: dict) -> list[int]:
-    """The targets a run tracks, each with its own filter: the model's ``targets``, else the
-    scene's ``track`` list, else ``target`` (default 0)."""
-    default = model.get("scene_spec", {}).get("track", [model.get("target", 0)])
-    return list(model.get("targets", default))
+def targets(model: dict, n_targets: int) -> list[int]:
+    """The targets a run tracks: the model's ``targets``, else the scene's ``track`` (a list, or
+    ``all``), else ``target`` (default 0)."""
+    chosen = model.get("targets", model.get("scene_spec", {}).get("track", [model.get("target", 0)]))
+    return list(range(n_targets)) if chosen == "all" else list(chosen)
 
 
 def check(model: dict, method: dict) -> None:
@@ -38,7 +38,7 @@ def check(model: dict, method: dict) -> None:
     if observation.get("kind", "colour") not in OBSERVATIONS:
         raise ValueError(f"unknown observation {observation.get('kind')!r}; choose one of {OBSERVATIONS}")
     sequence = cached_sequence(model["scene_spec"])
-    for target in targets(model):
+    for target in targets(model, sequence.truth.shape[1]):
         if not 0 <= target < sequence.truth.shape[1]:
             raise ValueError(f"target {target} not in the scene's {sequence.truth.shape[1]} targets")
     ColourHistogram(**_histogram_args(observation, (8, 8), np.random.default_rng(0)))  # validation only
@@ -96,7 +96,7 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
 def run(run: Run) -> dict:
     """Track every target of the run; numbers are averaged over targets, 'tracked to the end' needs all."""
     sequence = cached_sequence(run.model["scene_spec"])
-    chosen = targets(run.model)
+    chosen = targets(run.model, sequence.truth.shape[1])
     cache: dict = {}
     method = build_filter(run.method, run.method_params)
     if getattr(method, "joint", False):  # one filter for all targets
