@@ -40,6 +40,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                 continue
             build = build_rating_table if table_spec.get("kind") == "rating" else build_table
             table, hits = build(records, table_spec, experiment, published)
+            if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
+                continue
             matched |= hits
             verdicts.update(v.split(" (")[0] for v in table["verdict"])
             csv = f"{table_spec['name']}.csv"

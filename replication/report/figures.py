@@ -57,13 +57,14 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
 
 
 def _figures():
-    from replication.report.tracking_figures import per_frame_curve, snapshots, track
+    from replication.report.tracking_figures import mode_strip, per_frame_curve, snapshots, track
 
     return {
         "metric_vs_condition": metric_vs_condition,
         "per_frame_curve": per_frame_curve,
         "track": track,
         "snapshots": snapshots,
+        "mode_strip": mode_strip,
     }
 
 

@@ -134,3 +134,33 @@ def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, index: int
             x, y, w, h = box
             cv2.rectangle(image, (int(x), int(y)), (int(x + w), int(y + h)), colour, 1)
     return image
+
+
+def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """The marginal posterior of one target over x or y, frame by frame (first run of each method),
+    with every target's true coordinate drawn over it: does a hidden target keep both modes?"""
+    stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
+    runs = list(_first_runs(stripped).iterrows())
+    if not runs:
+        raise ValueError("no run recorded a strip: give the scene a strip: {target: ...} block")
+    fig, axes = plt.subplots(len(runs), 1, figsize=(7, 2.6 * len(runs)), squeeze=False)
+    for ax, (_, run) in zip(axes[:, 0], runs):
+        sequence, _ = _sequence(experiment, run.to_frame().T)
+        density = np.array(run["strip"]["density"])  # (T - 1, bins)
+        axis = "xy".index(run["strip"]["axis"])
+        ax.imshow(density.T, origin="lower", aspect="auto", cmap="magma",
+                  extent=(1, density.shape[0], 0, sequence.size[axis]))
+        centres = sequence.truth[1:, :, axis] + sequence.truth[1:, :, axis + 2] / 2
+        for m in range(centres.shape[1]):
+            ax.plot(np.arange(1, len(centres) + 1), centres[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
+        first, last = spec.get("window", (None, None))
+        if first is not None:
+            ax.axvspan(first, last, color="w", alpha=0.08)
+        ax.set_title(f"{_label(experiment, run['method'])}: target {run['strip']['target'] + 1}", fontsize=9)
+        ax.set_ylabel(f"{run['strip']['axis']} (px)")
+        ax.legend(fontsize=6, loc="upper left")
+    axes[-1, 0].set_xlabel("frame")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

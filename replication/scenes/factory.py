@@ -23,7 +23,7 @@ def build_sequence(spec: dict):
         if missing:
             raise SequenceMissing(missing[0])
         return OTBSequence(spec["name"], root, spec.get("first", 0), spec.get("last"), spec.get("stand_in"))
-    scene = {k: v for k, v in spec.items() if k not in ("kind", "name", "stand_in", "track", "evaluation")}
+    scene = {k: v for k, v in spec.items() if k not in ("kind", "name", "stand_in", "track", "evaluation", "strip")}
     return SyntheticScene(scene, name=spec.get("name", "synthetic"), stand_in=spec.get("stand_in"))
 
 

@@ -93,6 +93,17 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
     }
 
 
+def _marginal(filters: list, index: int, strip: dict, size: tuple[int, int]) -> np.ndarray:
+    """Target ``index``'s posterior over one coordinate (``strip.axis``, x or y) now: a weighted histogram."""
+    method, state = filters[0] if len(filters) == 1 else filters[index]
+    particles = state.particles[index] if getattr(method, "joint", False) else state.particles
+    log_weights = state.log_weights[index] if getattr(method, "joint", False) else state.log_weights
+    weights = np.exp(log_weights - log_weights.max())
+    axis = "xy".index(strip.get("axis", "x"))
+    density, _ = np.histogram(particles[:, axis], bins=strip.get("bins", 60), range=(0, size[axis]), weights=weights)
+    return density / max(density.sum(), 1e-300)
+
+
 def run(run: Run) -> dict:
     """Track every target of the run; numbers are averaged over targets, 'tracked to the end' needs all."""
     sequence = cached_sequence(run.model["scene_spec"])
@@ -107,6 +118,8 @@ def run(run: Run) -> dict:
         for target in chosen:
             method = build_filter(run.method, run.method_params)
             filters.append((method, method.start(build_model(run, sequence, target, cache), run.rng(f"filter{target}"))))
+    strip = run.model["scene_spec"].get("strip")  # a target whose marginal over x is kept per frame
+    densities = []
     seconds = 0.0
     for k in range(1, sequence.n_frames):
         frame = sequence.frame(k)
@@ -114,6 +127,8 @@ def run(run: Run) -> dict:
         for method, state in filters:
             method.step(state, frame)
         seconds += time.perf_counter() - started
+        if strip:
+            densities.append(_marginal(filters, chosen.index(strip["target"]), strip, sequence.size))
     outputs = filters[0][1].outputs() if getattr(method, "joint", False) else [state.output() for _, state in filters]
     diagnostics = [filter_diagnostics(output) for output in outputs]
     boxes = [BoxModel.boxes(output.means) for output in outputs]
@@ -139,6 +154,8 @@ def run(run: Run) -> dict:
         correct = tm.correct_frames(errors[scored], overlaps[scored], rule)
         record[f"correct_frames[{rule}]"] = float(correct.mean())
         record[f"tracked_to_end[{rule}]"] = float(all(tm.tracked_to_end(c) for c in correct.T))
+    if strip:
+        record["strip"] = {"target": strip["target"], "axis": strip.get("axis", "x"), "density": np.round(densities, 4).tolist()}
     record["per_frame"] = {
         "cle": np.round(errors.mean(axis=1), 3).tolist(),
         "iou": np.round(overlaps.mean(axis=1), 4).tolist(),
