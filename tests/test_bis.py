@@ -52,3 +52,39 @@ def test_the_3123_scene_shows_3_then_1_then_2_then_3_targets():
     assert np.all(visible[72:93] == 2)  # 2 is out again
     assert np.all(visible[95:] == 3)  # 3 comes out of 1 after frame 93
     assert np.all(scene.visibility[51:93, 2] == 0)  # target 3 hidden throughout
+
+
+def test_mrf_jpf_weights_are_likelihoods_times_potentials():
+    """One step of MRF-JPF on two targets with a known likelihood and no motion noise."""
+    from replication.filters.bis import MRFJPF
+
+    class Still:
+        def __init__(self, particles, log_like):
+            self.particles, self.log_like = particles, log_like
+
+        def sample_initial(self, n, rng):
+            return self.particles.copy()
+
+        def propagate(self, particles, t, rng):
+            return particles
+
+        def log_likelihood(self, particles, z, t):
+            return self.log_like(particles)
+
+    first = np.array([[0.0, 0, 4, 4], [2.0, 0, 4, 4], [20.0, 0, 4, 4]])
+    second = np.array([[1.0, 0, 4, 4], [1.0, 0, 4, 4], [30.0, 0, 4, 4]])
+    models = [Still(first, lambda x: -x[:, 0] / 10), Still(second, lambda x: np.zeros(len(x)))]
+    jpf = MRFJPF(n_particles=3, beta=2.0)
+    state = jpf.start(models, np.random.default_rng(0))
+    with np.errstate(divide="ignore"):
+        state.log_weights = [np.log(np.array([0.0, 0.0, 1.0]))] * 2  # resampling keeps particle 3 only
+    jpf.step(state, None)
+    np.testing.assert_array_equal(state.particles[0], first[[2, 2, 2]])
+    np.testing.assert_allclose(np.exp(state.log_weights[0]), 1 / 3)  # identical joint particles
+    state.log_weights = [np.full(3, -np.log(3))] * 2
+    state.particles = [first, second]
+    jpf.step(state, None)
+    moved = state.particles
+    expected = np.exp(-moved[0][:, 0] / 10 + log_potential(moved[0], moved[1], 2.0))
+    np.testing.assert_allclose(np.exp(state.log_weights[0]), expected / expected.sum())
+    np.testing.assert_array_equal(state.log_weights[0], state.log_weights[1])  # one joint weight per row

@@ -7,7 +7,7 @@ the rest of its keys to it.  A filter with ``joint = True`` (BIS-PF) tracks all
 targets of a run together: ``start(models, rng)`` and ``step(state, z)``.
 """
 
-from replication.filters.bis import BISPF
+from replication.filters.bis import BISPF, MRFJPF
 from replication.filters.bootstrap import bootstrap
 from replication.filters.ism import ism
 from replication.filters.point_mass import PointMassFilter
@@ -19,6 +19,7 @@ FILTERS = {
     "pso": pso,
     "ism": ism,
     "bis": BISPF,
+    "mrf_jpf": MRFJPF,
 }
 
-__all__ = ["BISPF", "FILTERS", "PointMassFilter", "bootstrap", "ism", "pso"]
+__all__ = ["BISPF", "FILTERS", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]

@@ -1,4 +1,6 @@
-"""BIS-PF: bootstrap importance sampling for multi-target tracking (bis_pf, section 2).
+"""Joint multi-target filters with the bis_pf MRF: BIS-PF (bis_pf, section 2) and MRF-JPF (Khan et al. 2004).
+
+BIS-PF:
 
 Per frame, with M targets of N particles each:
 
@@ -14,6 +16,12 @@ Per frame, with M targets of N particles each:
 
 The K x M draws are one inverse-CDF call per target; only pairs of targets
 whose particle clouds can overlap contribute factors, each over all K at once.
+
+MRF-JPF: N joint particles, each holding every target's state; each target's
+part moves by its own motion model; the joint weight is the product of the
+targets' likelihoods and of the pairwise potentials (the same phi as BIS-PF,
+so the two differ only in inference); resampled jointly every frame.  Its cost
+and variance grow exponentially with the number of targets.
 """
 
 from dataclasses import dataclass
@@ -48,16 +56,22 @@ def _extent(particles: np.ndarray) -> np.ndarray:
     return np.concatenate([(particles[:, :2] - half).min(axis=0), (particles[:, :2] + half).max(axis=0)])
 
 
+def pairwise_log_potential(states: list, beta: float) -> np.ndarray:
+    """sum over target pairs whose clouds can overlap of log phi, for aligned samples states[i][k]."""
+    total = np.zeros(len(states[0]))
+    extents = [_extent(p) for p in states]
+    for i in range(len(states)):
+        for j in range(i + 1, len(states)):
+            a, b = extents[i], extents[j]
+            if a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]:  # only clouds that can overlap
+                total += log_potential(states[i], states[j], beta)
+    return total
+
+
 def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np.random.Generator) -> list:
     """The marginal posteriors W_i (eq 10) from K joint bootstrap draws weighted by the MRF (eqs 5-8, 11)."""
     draws = [multinomial(p, rng, size=k) for p in pi]  # B_i(k), eq (5)
-    log_w = np.zeros(k)
-    extents = [_extent(p) for p in particles]
-    for i in range(len(particles)):
-        for j in range(i + 1, len(particles)):
-            a, b = extents[i], extents[j]
-            if a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]:  # only clouds that can overlap
-                log_w += log_potential(particles[i][draws[i]], particles[j][draws[j]], beta)
+    log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta)  # eq (8)
     w = np.exp(log_w - log_w.max())
     histograms = [np.bincount(d, weights=w, minlength=len(p)) for d, p in zip(draws, particles)]
     return [h / h.sum() for h in histograms]
@@ -74,6 +88,17 @@ class JointState:
     def __post_init__(self):
         self.records = [{k: [] for k in ("means", "variances", "ess", "resampled", "degenerate")} for _ in self.models]
 
+    def record(self, i: int, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
+        """Store target i's weighted particles after a step and what a FilterOutput reports of them."""
+        with np.errstate(divide="ignore"):
+            self.particles[i], self.log_weights[i] = particles, np.log(weights)
+        record = self.records[i]
+        record["means"].append(weighted_mean(particles, weights))
+        record["variances"].append(weighted_variance(particles, weights))
+        record["ess"].append(ess(weights))
+        record["resampled"].append(True)
+        record["degenerate"].append(degenerate)
+
     def outputs(self) -> list[FilterOutput]:
         return [
             FilterOutput(
@@ -88,24 +113,30 @@ class JointState:
         ]
 
 
+class JointFilter:
+    """What the joint filters share: one state for all targets, started from each target's prior."""
+
+    joint = True  # the tracking task hands such a filter every target of a run
+    n_particles: int
+
+    def start(self, models: list, rng: np.random.Generator) -> JointState:
+        n = self.n_particles
+        return JointState(models, rng, [m.sample_initial(n, rng) for m in models], [np.full(n, -np.log(n)) for _ in models])
+
+
 @dataclass
-class BISPF:
+class BISPF(JointFilter):
     """M bootstrap PFs of ``n_particles`` joined by ``n_joint`` (K) bootstrap draws and the MRF potential."""
 
     n_particles: int = 400
     n_joint: int = 4000
     beta: float = 4.0
-    joint = True  # one filter for all targets of a run
 
     def __post_init__(self):
         if self.n_particles <= 0 or self.n_joint <= 0:
             raise ValueError(f"N and K must be positive, got N={self.n_particles}, K={self.n_joint}")
         if self.beta < 0:
             raise ValueError(f"beta must be non-negative, got {self.beta}")
-
-    def start(self, models: list, rng: np.random.Generator) -> JointState:
-        n = self.n_particles
-        return JointState(models, rng, [m.sample_initial(n, rng) for m in models], [np.full(n, -np.log(n)) for _ in models])
 
     def step(self, state: JointState, z) -> None:
         rng, n = state.rng, self.n_particles
@@ -125,12 +156,31 @@ class BISPF:
             local.append(pi)
         histograms = bootstrap_histograms(proposed, local, self.n_joint, self.beta, rng)
         for i, (particles, histogram) in enumerate(zip(proposed, histograms)):
-            with np.errstate(divide="ignore"):
-                state.log_weights[i] = np.log(histogram)
-            state.particles[i] = particles
-            record = state.records[i]
-            record["means"].append(weighted_mean(particles, histogram))
-            record["variances"].append(weighted_variance(particles, histogram))
-            record["ess"].append(ess(histogram))
-            record["resampled"].append(True)
-            record["degenerate"].append(degenerate[i])
+            state.record(i, particles, histogram, degenerate[i])
+
+
+@dataclass
+class MRFJPF(JointFilter):
+    """Joint particle filter over all targets with the MRF interaction (Khan, Balch, Dellaert 2004)."""
+
+    n_particles: int = 6000
+    beta: float = 4.0
+
+    def __post_init__(self):
+        if self.n_particles <= 0 or self.beta < 0:
+            raise ValueError(f"need N > 0 and beta >= 0, got N={self.n_particles}, beta={self.beta}")
+
+    def step(self, state: JointState, z) -> None:
+        rng, n = state.rng, self.n_particles
+        state.t += 1
+        ancestors = multinomial(np.exp(state.log_weights[0]), rng)  # one joint resampling: rows stay aligned
+        moved = [model.propagate(p[ancestors], state.t, rng) for model, p in zip(state.models, state.particles)]
+        log_w = sum(model.log_likelihood(p, z, state.t) for model, p in zip(state.models, moved))
+        log_w = log_w + pairwise_log_potential(moved, self.beta)
+        try:
+            weights, _ = normalise(log_w)
+            degenerate = False
+        except DegenerateWeightsError:
+            weights, degenerate = np.full(n, 1.0 / n), True
+        for i, particles in enumerate(moved):
+            state.record(i, particles, weights, degenerate)

@@ -5,7 +5,8 @@ methods takes the entry of the current scale (e.g. a scene's frame count).
 The ``sweep:`` block of ``model`` or of a method lists the values a parameter
 takes (``sweep: {n_particles: [500, 200, 100]}``): the runs are the product
 method x swept values x repetition.  Everything else is a parameter, lists
-included (a velocity clamp, histogram bins).  Everything is checked
+included (a velocity clamp, histogram bins).  A method's ``only:`` block
+(``only: {scene: [a]}``) keeps it to the conditions with those values.  Everything is checked
 before any work starts, and errors are one line that names the bad key.
 """
 
@@ -142,6 +143,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
             what = f"unknown filter {params['filter']!r}" if "filter" in params else "no 'filter:' key"
             raise ConfigError(f"method {method!r}: {what}; known filters: {', '.join(sorted(FILTERS))}")
         sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
+        only = params.pop("only", None) or {}  # e.g. {scene: [exp1_3123]}: a method run on some conditions only
         for values in itertools.product(*(values for _, _, values in sweeps)):
             run_model, run_params = dict(model), dict(params)
             labels, data_labels = [], []
@@ -151,6 +153,8 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
                 if on_model:
                     data_labels.append(labels[-1])
             condition = ";".join(labels)
+            if any(run_model.get(k, run_params.get(k)) not in allowed for k, allowed in only.items()):
+                continue
             if "scene" in run_model:
                 if run_model["scene"] not in scenes:
                     raise ConfigError(f"model.scene {run_model['scene']!r} is not in experiment.scenes {sorted(scenes)}")
