@@ -88,3 +88,38 @@ def test_mrf_jpf_weights_are_likelihoods_times_potentials():
     expected = np.exp(-moved[0][:, 0] / 10 + log_potential(moved[0], moved[1], 2.0))
     np.testing.assert_allclose(np.exp(state.log_weights[0]), expected / expected.sum())
     np.testing.assert_array_equal(state.log_weights[0], state.log_weights[1])  # one joint weight per row
+
+
+def _state(n_targets):
+    from replication.filters.bis import JointState
+
+    return JointState([None] * n_targets, np.random.default_rng(0), [None] * n_targets, [None] * n_targets)
+
+
+def test_mean_field_one_iteration_by_hand():
+    from replication.filters.mean_field import MFMC
+
+    first = np.array([[0.0, 0, 4, 4], [10.0, 0, 4, 4]])
+    second = np.array([[0.0, 0, 4, 4], [2.0, 0, 4, 4]])
+    pi = [np.array([0.5, 0.5]), np.array([0.25, 0.75])]
+    (q1, q2) = MFMC(n_particles=2, iterations=1, beta=2.0).interact([first, second], pi, _state(2))
+    table = log_potential(first[:, None], second[None, :], 2.0)  # (2, 2)
+    expected1 = pi[0] * np.exp(table @ pi[1])
+    expected2 = pi[1] * np.exp(table.T @ pi[0])
+    np.testing.assert_allclose(q1, expected1 / expected1.sum())
+    np.testing.assert_allclose(q2, expected2 / expected2.sum())
+    far = [first, second + [100, 0, 0, 0]]
+    np.testing.assert_allclose(MFMC(n_particles=2, iterations=5).interact(far, pi, _state(2))[0], pi[0])
+
+
+def test_dmot_repels_particles_from_a_neighbours_estimate():
+    from replication.filters.dmot import DMOT
+
+    first = np.array([[0.0, 0, 20, 20], [15.0, 0, 20, 20]])
+    second = np.array([[0.0, 0, 20, 20], [0.0, 0, 20, 20]])  # the neighbour sits on first's particle 1
+    pi = [np.array([0.5, 0.5]), np.array([0.5, 0.5])]
+    w1, _ = DMOT(n_particles=2, iterations=1, alpha1=2.0, sigma1=20.0).interact([first, second], pi, _state(2))
+    factors = np.array([1 - 0.5, 1 - 0.5 * np.exp(-(15.0**2) / 400)])  # inertia is 1 without a history
+    np.testing.assert_allclose(w1, factors / factors.sum())
+    alone = DMOT(n_particles=2).interact([first, second + [200, 0, 0, 0]], pi, _state(2))
+    np.testing.assert_allclose(alone[0], pi[0])

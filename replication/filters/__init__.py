@@ -9,7 +9,9 @@ targets of a run together: ``start(models, rng)`` and ``step(state, z)``.
 
 from replication.filters.bis import BISPF, MRFJPF
 from replication.filters.bootstrap import bootstrap
+from replication.filters.dmot import DMOT
 from replication.filters.ism import ism
+from replication.filters.mean_field import MFMC
 from replication.filters.point_mass import PointMassFilter
 from replication.filters.pso import pso
 
@@ -20,6 +22,8 @@ FILTERS = {
     "ism": ism,
     "bis": BISPF,
     "mrf_jpf": MRFJPF,
+    "mfmc": MFMC,
+    "dmot": DMOT,
 }
 
-__all__ = ["BISPF", "FILTERS", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]
+__all__ = ["BISPF", "DMOT", "FILTERS", "MFMC", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]

@@ -50,6 +50,18 @@ def log_potential(a: np.ndarray, b: np.ndarray, beta: float) -> np.ndarray:
     return -beta * ratio**2
 
 
+def neighbours(particles: list) -> list[tuple[int, int]]:
+    """Pairs of targets whose particle clouds can overlap: the MRF's edges this frame."""
+    extents = [_extent(p) for p in particles]
+    return [
+        (i, j)
+        for i in range(len(particles))
+        for j in range(i + 1, len(particles))
+        if extents[i][0] < extents[j][2] and extents[j][0] < extents[i][2]
+        and extents[i][1] < extents[j][3] and extents[j][1] < extents[i][3]
+    ]
+
+
 def _extent(particles: np.ndarray) -> np.ndarray:
     """The box (left, top, right, bottom) covering every particle's box."""
     half = particles[:, 2:4] / 2
@@ -59,12 +71,8 @@ def _extent(particles: np.ndarray) -> np.ndarray:
 def pairwise_log_potential(states: list, beta: float) -> np.ndarray:
     """sum over target pairs whose clouds can overlap of log phi, for aligned samples states[i][k]."""
     total = np.zeros(len(states[0]))
-    extents = [_extent(p) for p in states]
-    for i in range(len(states)):
-        for j in range(i + 1, len(states)):
-            a, b = extents[i], extents[j]
-            if a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]:  # only clouds that can overlap
-                total += log_potential(states[i], states[j], beta)
+    for i, j in neighbours(states):
+        total += log_potential(states[i], states[j], beta)
     return total
 
 
@@ -124,8 +132,36 @@ class JointFilter:
         return JointState(models, rng, [m.sample_initial(n, rng) for m in models], [np.full(n, -np.log(n)) for _ in models])
 
 
+class DistributedFilter(JointFilter):
+    """M bootstrap PFs, one per target, whose weights an ``interact`` stage then couples.
+
+    Each frame every target resamples from its weights, moves by its own
+    motion and is weighted by its own likelihood pi (bis_pf's step 1, and the
+    starting point of MFMC and DMOT); ``interact(particles, pi, state)``
+    returns each target's final normalised weights.
+    """
+
+    def step(self, state: JointState, z) -> None:
+        rng, n = state.rng, self.n_particles
+        state.t += 1
+        proposed, local, degenerate = [], [], []
+        for i, model in enumerate(state.models):
+            ancestors = multinomial(np.exp(state.log_weights[i]), rng)
+            particles = model.propagate(state.particles[i][ancestors], state.t, rng)
+            try:
+                pi, _ = normalise(model.log_likelihood(particles, z, state.t))
+                degenerate.append(False)
+            except DegenerateWeightsError:  # nothing seen: the prediction stands
+                pi = np.full(n, 1.0 / n)
+                degenerate.append(True)
+            proposed.append(particles)
+            local.append(pi)
+        for i, (particles, weights) in enumerate(zip(proposed, self.interact(proposed, local, state))):
+            state.record(i, particles, weights, degenerate[i])
+
+
 @dataclass
-class BISPF(JointFilter):
+class BISPF(DistributedFilter):
     """M bootstrap PFs of ``n_particles`` joined by ``n_joint`` (K) bootstrap draws and the MRF potential."""
 
     n_particles: int = 400
@@ -138,25 +174,8 @@ class BISPF(JointFilter):
         if self.beta < 0:
             raise ValueError(f"beta must be non-negative, got {self.beta}")
 
-    def step(self, state: JointState, z) -> None:
-        rng, n = state.rng, self.n_particles
-        state.t += 1
-        proposed, local, degenerate = [], [], []
-        for i, model in enumerate(state.models):  # step 1: independent bootstrap PFs
-            ancestors = multinomial(np.exp(state.log_weights[i]), rng)
-            particles = model.propagate(state.particles[i][ancestors], state.t, rng)
-            log_pi = model.log_likelihood(particles, z, state.t)
-            try:
-                pi, _ = normalise(log_pi)
-                degenerate.append(False)
-            except DegenerateWeightsError:  # nothing seen: the prediction stands
-                pi = np.full(n, 1.0 / n)
-                degenerate.append(True)
-            proposed.append(particles)
-            local.append(pi)
-        histograms = bootstrap_histograms(proposed, local, self.n_joint, self.beta, rng)
-        for i, (particles, histogram) in enumerate(zip(proposed, histograms)):
-            state.record(i, particles, histogram, degenerate[i])
+    def interact(self, particles: list, pi: list, state: JointState) -> list:
+        return bootstrap_histograms(particles, pi, self.n_joint, self.beta, state.rng)
 
 
 @dataclass
