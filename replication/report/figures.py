@@ -6,6 +6,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from replication.report.aggregate import summarise  # noqa: E402
@@ -18,7 +19,8 @@ def parse_condition(condition: str) -> dict[str, str]:
 def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
-    ``by`` (a swept variable) splits the figure into one panel per value.  A
+    ``by`` (a swept variable) splits the figure into one panel per value;
+    ``fit_slope`` adds each series' log-log slope to its label.  A
     method that does not sweep ``x`` (the point-mass reference, say) is drawn
     as a horizontal band.
     """
@@ -37,6 +39,9 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
         rows = summary[summary["panel"] == panel]
         for series, group in rows[rows["x"].notna()].groupby("series", sort=False):
             group = group.sort_values("x")
+            if spec.get("fit_slope") and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
+                slope = np.polyfit(np.log(group["x"]), np.log(group["mean"]), 1)[0]
+                series = f"{series} (slope {slope:.2f})"
             ax.plot(group["x"], group["mean"], marker="o", label=series)
             ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
         for _, row in rows[rows["x"].isna()].iterrows():

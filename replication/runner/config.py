@@ -24,7 +24,7 @@ from replication.filters import FILTERS
 from replication.runner.seeding import seed_sequence
 
 SCALES = ("paper", "quick")
-SHORT_NAMES = {"n_particles": "N", "steps": "T"}
+SHORT_NAMES = {"n_particles": "N", "steps": "T", "n_joint": "K"}
 
 
 class ConfigError(ValueError):
