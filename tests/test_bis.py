@@ -123,3 +123,57 @@ def test_dmot_repels_particles_from_a_neighbours_estimate():
     np.testing.assert_allclose(w1, factors / factors.sum())
     alone = DMOT(n_particles=2).interact([first, second + [200, 0, 0, 0]], pi, _state(2))
     np.testing.assert_allclose(alone[0], pi[0])
+
+
+def test_mcmc_chain_samples_the_posterior_of_one_target():
+    """Independence MH from the predictive N(0, 1) with likelihood N(3; x, 1): the posterior is N(1.5, 0.5)."""
+    from replication.filters.mcmc import MCMCPF
+
+    class Line:
+        def sample_initial(self, n, rng):
+            return np.tile([0.0, 0.0, 4.0, 4.0], (n, 1))
+
+        def propagate(self, particles, t, rng):
+            moved = particles.copy()
+            moved[:, 0] = rng.standard_normal(len(particles))  # x_t ~ N(0, 1) whatever x_{t-1}
+            return moved
+
+        def log_likelihood(self, particles, z, t):
+            return -0.5 * (particles[:, 0] - 3.0) ** 2
+
+    mcmc = MCMCPF(n_particles=40_000, burn_in=0.25, carry=10)
+    state = mcmc.start([Line()], np.random.default_rng(0))
+    mcmc.step(state, None)
+    output = state.outputs()[0]
+    assert output.means[0][0] == pytest.approx(1.5, abs=0.05)
+    assert output.variances[0][0] == pytest.approx(0.5, rel=0.1)
+    assert state.carried[0].shape == (10, 4)  # the samples carried to the next frame
+    assert np.all(np.abs(state.carried[0][:, 0] - 3.0) < 0.2)  # the best by likelihood sit at its peak
+
+
+def test_mcmc_potential_keeps_two_targets_apart():
+    """Two targets whose likelihoods both peak at x = 0: the MRF pushes the pair apart."""
+    from replication.filters.mcmc import MCMCPF
+
+    class Peak:
+        def sample_initial(self, n, rng):
+            return np.tile([0.0, 0.0, 10.0, 10.0], (n, 1))
+
+        def propagate(self, particles, t, rng):
+            moved = particles.copy()
+            moved[:, 0] = rng.uniform(-15, 15, len(particles))
+            return moved
+
+        def log_likelihood(self, particles, z, t):
+            return -0.5 * (particles[:, 0] / 5.0) ** 2
+
+    # the carried best samples: overlapping pairs are penalised, so the best keep apart
+    mcmc = MCMCPF(n_particles=20_000, beta=50.0)
+    state = mcmc.start([Peak(), Peak()], np.random.default_rng(2))
+    mcmc.step(state, None)
+    free = MCMCPF(n_particles=20_000, beta=0.0)
+    free_state = free.start([Peak(), Peak()], np.random.default_rng(2))
+    free.step(free_state, None)
+    gap = np.abs(state.carried[0][:, 0] - state.carried[1][:, 0]).mean()
+    free_gap = np.abs(free_state.carried[0][:, 0] - free_state.carried[1][:, 0]).mean()
+    assert gap > free_gap

@@ -11,6 +11,7 @@ from replication.filters.bis import BISPF, MRFJPF
 from replication.filters.bootstrap import bootstrap
 from replication.filters.dmot import DMOT
 from replication.filters.ism import ism
+from replication.filters.mcmc import MCMCPF
 from replication.filters.mean_field import MFMC
 from replication.filters.point_mass import PointMassFilter
 from replication.filters.pso import pso
@@ -24,6 +25,7 @@ FILTERS = {
     "mrf_jpf": MRFJPF,
     "mfmc": MFMC,
     "dmot": DMOT,
+    "mcmc": MCMCPF,
 }
 
-__all__ = ["BISPF", "DMOT", "FILTERS", "MFMC", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]
+__all__ = ["BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]
