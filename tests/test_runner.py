@@ -13,7 +13,7 @@ import pytest
 from conftest import SMALL
 
 from replication.paths import PROJECT_ROOT
-from replication.runner.config import ConfigError, expand
+from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.seeding import seed_sequence
 from replication.runner.store import Store
