@@ -6,6 +6,8 @@
    histogram it stands for) and a per-particle numpy loop of the same kernel histogram.
 2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6.
 3. Rendering a 480 x 410 synthetic frame with 36 targets.
+4. BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second
+   against the paper's 5.52, and a profile of where the time goes.
 
 Writes ``reports/benchmark/`` (CSV, figures, a page the report index links).
 A script, not a test: timings depend on the machine and its load.
@@ -115,6 +117,53 @@ def rendering() -> pd.DataFrame:
                           "ms_per_target": 1e3 * seconds / 36}])
 
 
+def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame]:
+    """BIS-PF's frame rate on the bis_pf 36-ball scene, and its profile by function."""
+    import cProfile
+    import pstats
+
+    from omegaconf import OmegaConf
+
+    from replication.filters.bis import BISPF
+    from replication.paths import CONF_DIR
+    from replication.runner.config import at_scale
+    from replication.scenes.factory import build_sequence
+    from replication.tasks.tracking import build_model
+
+    experiment = at_scale(OmegaConf.to_container(OmegaConf.load(CONF_DIR / "experiment" / "bis_pf.yaml")), "quick")
+    scene = build_sequence(experiment["scenes"]["exp3_36_targets"])
+    frames = [scene.frame(k) for k in range(1, 41)]
+
+    class Run:  # what build_model reads of a run
+        model = {**experiment["model"], "scene_spec": experiment["scenes"]["exp3_36_targets"]}
+
+        @staticmethod
+        def rng(stream):
+            return np.random.default_rng(0)
+
+    cache: dict = {}
+    models = [build_model(Run, scene, m, cache) for m in range(36)]
+    bis = BISPF(n_particles=400, n_joint=4000, beta=4.0)
+    state = bis.start(models, np.random.default_rng(1))
+    started = time.perf_counter()
+    for frame in frames[:20]:
+        bis.step(state, frame)
+    fps = 20 / (time.perf_counter() - started)
+    profile = cProfile.Profile()
+    profile.enable()
+    for frame in frames[20:]:
+        bis.step(state, frame)
+    profile.disable()
+    stats = pstats.Stats(profile).stats
+    rows = sorted(
+        ({"function": f"{name[2]} ({name[0].rsplit('/', 1)[-1]}:{name[1]})", "seconds (self)": tt, "calls": nc}
+         for name, (cc, nc, tt, ct, callers) in stats.items()),
+        key=lambda r: -r["seconds (self)"],
+    )[:12]
+    speed = pd.DataFrame([{"scene": "36 balls, 480x410", "N": 400, "K": 4000, "frames_per_s": fps, "paper_frames_per_s": 5.52}])
+    return speed, pd.DataFrame(rows)
+
+
 def _loglog(table, x, y, group, path, ylabel):
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for name, rows in table.groupby(group, sort=False):
@@ -132,7 +181,9 @@ def main() -> None:
     out = resolve("reports") / "benchmark"
     out.mkdir(parents=True, exist_ok=True)
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
-    for name, table in (("likelihood", likelihood), ("smc_core", core), ("rendering", render_cost)):
+    bis_speed, bis_profile = bis_pf_36()
+    for name, table in (("likelihood", likelihood), ("smc_core", core), ("rendering", render_cost),
+                        ("bis_pf_speed", bis_speed), ("bis_pf_profile", bis_profile)):
         table.to_csv(out / f"{name}.csv", index=False)
         print(table.to_string(index=False), end="\n\n")
     per_particle = likelihood[~likelihood["method"].str.startswith("per frame")]
@@ -148,6 +199,10 @@ def main() -> None:
                  "figure": "likelihood.png", "table": html_table(likelihood.round(5))},
                 {"title": "SMC core", "figure": "smc_core.png", "table": html_table(core.round(2))},
                 {"title": "Scene rendering", "figure": None, "table": html_table(render_cost.round(3))},
+                {"title": "BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second",
+                 "figure": None, "table": html_table(bis_speed.round(2))},
+                {"title": "BIS-PF profile over 20 frames: where the time goes (self time per function)",
+                 "figure": None, "table": html_table(bis_profile.round(4))},
             ],
         )
     )
