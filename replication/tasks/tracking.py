@@ -95,9 +95,10 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
 
 def _marginal(filters: list, index: int, strip: dict, size: tuple[int, int]) -> np.ndarray:
     """Target ``index``'s posterior over one coordinate (``strip.axis``, x or y) now: a weighted histogram."""
-    method, state = filters[0] if len(filters) == 1 else filters[index]
-    particles = state.particles[index] if getattr(method, "joint", False) else state.particles
-    log_weights = state.log_weights[index] if getattr(method, "joint", False) else state.log_weights
+    joint = getattr(filters[0][0], "joint", False)
+    state = filters[0][1] if joint else filters[index][1]
+    particles = state.particles[index] if joint else state.particles
+    log_weights = state.log_weights[index] if joint else state.log_weights
     weights = np.exp(log_weights - log_weights.max())
     axis = "xy".index(strip.get("axis", "x"))
     density, _ = np.histogram(particles[:, axis], bins=strip.get("bins", 60), range=(0, size[axis]), weights=weights)
@@ -118,7 +119,7 @@ def run(run: Run) -> dict:
         for target in chosen:
             method = build_filter(run.method, run.method_params)
             filters.append((method, method.start(build_model(run, sequence, target, cache), run.rng(f"filter{target}"))))
-    strip = run.model["scene_spec"].get("strip")  # a target whose marginal over x is kept per frame
+    strip = run.model["scene_spec"].get("strip")  # a target whose marginal over x or y is kept per frame
     densities = []
     seconds = 0.0
     for k in range(1, sequence.n_frames):
