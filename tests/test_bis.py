@@ -177,3 +177,28 @@ def test_mcmc_potential_keeps_two_targets_apart():
     gap = np.abs(state.carried[0][:, 0] - state.carried[1][:, 0]).mean()
     free_gap = np.abs(free_state.carried[0][:, 0] - free_state.carried[1][:, 0]).mean()
     assert gap > free_gap
+
+
+def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
+    from conftest import SMALL
+
+    from replication.report.published import load_published
+    from replication.report.tables import build_rating_table
+    from replication.runner.config import expand
+    from replication.runner.execute import execute
+    from replication.runner.store import Store
+
+    cfg = make_cfg("bis_pf", *SMALL, "experiment.runs.quick=1", "experiment.model.sweep.scene=[exp1_3123]")
+    runs = [r for r in expand(cfg) if r.method in ("MIPF", "DMOT")]
+    store = Store(tmp_path / "store", "bis_pf")
+    execute(runs, store, n_jobs=1, progress=False)
+    records = store.load(runs)
+    for _, record in records.iterrows():
+        density = np.array(record["strip"]["density"])
+        assert density.shape == (129, 64) and np.allclose(density.sum(axis=1), 1.0, atol=2e-3)  # stored to 4 places
+        assert record["strip"]["axis"] == "y" and record["failed"] in (0.0, 1.0)
+    experiment = OmegaConf.to_container(cfg.experiment, resolve=True)
+    published = load_published(str(tmp_path / "absent.csv"))
+    spec = {"paper_table": "3", "metric": "failed", "paper_metric": "stability"}
+    table, _ = build_rating_table(records, spec, experiment, published)
+    assert set(table["ours"]) <= {"good", "medium", "poor"} and len(table) == 2
