@@ -21,7 +21,7 @@ from replication.runner.store import Store
 
 def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
     """Everything in a record except wall-clock timings, sorted by run."""
-    return frame.drop(columns=list(TIMING_COLUMNS)).sort_values("run_id").reset_index(drop=True)
+    return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
 
 
 @pytest.mark.parametrize(

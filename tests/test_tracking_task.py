@@ -56,3 +56,19 @@ def test_demo_experiment_runs_and_skips_a_missing_sequence(make_cfg, tmp_path):
     assert record["frames"] == 150 and len(record["per_frame"]["cle"]) == 150
     assert record["per_frame"]["cle"][0] == 0.0  # frame 1 is given, as in OTB's one-pass evaluation
     assert 0 < record["precision20"] <= 1 and record["mean_cle"] > 0
+
+
+def test_tracking_runs_are_identical_with_one_or_two_jobs(make_cfg, tmp_path):
+    from replication.runner.execute import TIMING_COLUMNS
+
+    cfg = make_cfg("ism_pf", *SMALL, "experiment.runs.quick=2", "experiment.model.sweep.scene=[office_standin]")
+    runs = [r for r in expand(cfg) if r.method in ("PF", "ISM-PF")]
+    frames = []
+    for label, n_jobs in (("one", 1), ("two", 2)):
+        store = Store(tmp_path / label, "ism_pf")
+        execute(runs, store, n_jobs=n_jobs, progress=False)
+        records = store.load(runs).drop(columns=list(TIMING_COLUMNS), errors="ignore")
+        frames.append(records.sort_values("run_id").reset_index(drop=True))
+    assert len(frames[0]) == 4
+    assert frames[0].drop(columns=["per_frame"]).equals(frames[1].drop(columns=["per_frame"]))
+    assert [p["box"] for p in frames[0]["per_frame"]] == [p["box"] for p in frames[1]["per_frame"]]

@@ -53,7 +53,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             file = f"{figure_spec['name']}.png"
             draw(records, figure_spec, experiment, out / file)
             figures.append({"title": figure_spec["title"], "file": file})
-        records.drop(columns=["per_frame"], errors="ignore").to_csv(out / "runs.csv", index=False)
+        records.drop(columns=["per_frame", "strip"], errors="ignore").to_csv(out / "runs.csv", index=False)
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
