@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.smc.loop import FilterOutput
+from replication.smc.loop import FilterOutput, Summaries
 from replication.smc.resampling import multinomial
-from replication.smc.weights import DegenerateWeightsError, ess, normalise, weighted_mean, weighted_variance
+from replication.smc.weights import DegenerateWeightsError, normalise
 
 
 def box_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -94,31 +94,17 @@ class JointState:
     t: int = 0
 
     def __post_init__(self):
-        self.records = [{k: [] for k in ("means", "variances", "ess", "resampled", "degenerate")} for _ in self.models]
+        self.records = [Summaries() for _ in self.models]
 
     def record(self, i: int, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
-        """Store target i's weighted particles after a step and what a FilterOutput reports of them."""
+        """Store target i's weighted particles after a step (the next step resamples them)."""
         with np.errstate(divide="ignore"):
             self.particles[i], self.log_weights[i] = particles, np.log(weights)
-        record = self.records[i]
-        record["means"].append(weighted_mean(particles, weights))
-        record["variances"].append(weighted_variance(particles, weights))
-        record["ess"].append(ess(weights))
-        record["resampled"].append(True)
-        record["degenerate"].append(degenerate)
+        self.records[i].add(particles, weights, degenerate)
+        self.records[i].resampled.append(True)
 
     def outputs(self) -> list[FilterOutput]:
-        return [
-            FilterOutput(
-                means=np.asarray(r["means"]),
-                variances=np.asarray(r["variances"]),
-                ess=np.asarray(r["ess"]),
-                resampled=np.asarray(r["resampled"], dtype=bool),
-                degenerate=np.asarray(r["degenerate"], dtype=bool),
-                log_evidence=float("nan"),
-            )
-            for r in self.records
-        ]
+        return [r.output(log_evidence=float("nan")) for r in self.records]
 
 
 class JointFilter:

@@ -42,7 +42,7 @@ class DMOT(DistributedFilter):
         for i, j in neighbours(particles):
             linked[i].append(j)
             linked[j].append(i)
-        inertia = [self.inertia(p, state.records[i]["means"]) if linked[i] else 1.0 for i, p in enumerate(particles)]
+        inertia = [self.inertia(p, state.records[i].means) if linked[i] else 1.0 for i, p in enumerate(particles)]
         weights = list(pi)
         for _ in range(self.iterations):
             estimates = [w @ p[:, :2] for w, p in zip(weights, particles)]

@@ -100,6 +100,33 @@ class FilterOutput:
 
 
 @dataclass
+class Summaries:
+    """What a filter records of its weighted particles after each step; becomes a FilterOutput."""
+
+    means: list = field(default_factory=list)
+    variances: list = field(default_factory=list)
+    ess: list = field(default_factory=list)
+    resampled: list = field(default_factory=list)
+    degenerate: list = field(default_factory=list)
+
+    def add(self, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
+        self.means.append(weighted_mean(particles, weights))
+        self.variances.append(weighted_variance(particles, weights))
+        self.ess.append(ess(weights))
+        self.degenerate.append(degenerate)
+
+    def output(self, log_evidence: float) -> FilterOutput:
+        return FilterOutput(
+            means=np.asarray(self.means),
+            variances=np.asarray(self.variances),
+            ess=np.asarray(self.ess),
+            resampled=np.asarray(self.resampled, dtype=bool),
+            degenerate=np.asarray(self.degenerate, dtype=bool),
+            log_evidence=log_evidence,
+        )
+
+
+@dataclass
 class FilterState:
     """A filter between steps: its particles, log-weights, random stream and what it has recorded."""
 
@@ -109,13 +136,10 @@ class FilterState:
     log_weights: np.ndarray
     t: int = 0
     log_evidence: float = 0.0
-    records: dict = field(default_factory=lambda: {k: [] for k in ("means", "variances", "ess", "resampled", "degenerate")})
+    records: Summaries = field(default_factory=Summaries)
 
     def output(self) -> FilterOutput:
-        arrays = {k: np.asarray(v) for k, v in self.records.items()}
-        arrays["resampled"] = arrays["resampled"].astype(bool)
-        arrays["degenerate"] = arrays["degenerate"].astype(bool)
-        return FilterOutput(**arrays, log_evidence=self.log_evidence)
+        return self.records.output(self.log_evidence)
 
 
 @dataclass
@@ -170,14 +194,10 @@ class ParticleFilter:
             degenerate = True
         state.log_evidence += log_total
         log_weights = log_weights - log_total
-        records = state.records
-        records["means"].append(weighted_mean(particles, weights))
-        records["variances"].append(weighted_variance(particles, weights))
-        records["ess"].append(ess(weights))
-        records["degenerate"].append(degenerate)
-        do_resample = self.resampling.wants(records["ess"][-1], n)
+        state.records.add(particles, weights, degenerate)
+        do_resample = self.resampling.wants(state.records.ess[-1], n)
         if do_resample:
             particles = particles[RESAMPLERS[self.resampling.scheme](weights, rng)]
             log_weights = np.full(n, -np.log(n))
-        records["resampled"].append(do_resample)
+        state.records.resampled.append(do_resample)
         state.particles, state.log_weights = particles, log_weights
