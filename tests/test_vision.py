@@ -52,6 +52,19 @@ def test_all_pixel_histograms_match_the_per_pixel_definition(kernel, bins):
         np.testing.assert_allclose(row, reference_histogram(FRAME, x0, y0, w, h, bins, kernel), atol=1e-12)
 
 
+@pytest.mark.parametrize("kernel", ["epanechnikov", "diagonal"])
+def test_bhattacharyya_from_counts_equals_it_from_normalised_histograms(kernel):
+    histogram = ColourHistogram(bins=(8, 8, 4), kernel=kernel, grid=(12, 9))
+    bin_image = hsv_bin_image(FRAME, histogram.bins)
+    boxes = np.column_stack([rng.uniform(-10, 90, 300), rng.uniform(-10, 70, 300), rng.uniform(3, 20, 300), rng.uniform(3, 20, 300)])
+    reference = histogram.of_boxes(bin_image, np.array([[30.0, 30.0, 12.0, 9.0]]))[0]
+    rho, valid = histogram.bhattacharyya(bin_image, boxes, reference)
+    normalised = histogram.of_boxes(bin_image, boxes)
+    np.testing.assert_allclose(rho, bhattacharyya(normalised, reference), atol=1e-12)
+    np.testing.assert_array_equal(valid, normalised.sum(axis=1) > 0)
+    assert (~valid).any() and valid.any()  # some boxes lie wholly outside the frame
+
+
 def test_box_outside_the_image_has_an_empty_histogram_and_minus_infinity():
     histogram = ColourHistogram(grid=(10, 10))
     likelihood = ColourLikelihood.from_frame(FRAME, np.array([40, 30, 10, 10]), histogram, sigma=0.1)

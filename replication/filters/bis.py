@@ -51,27 +51,25 @@ def log_potential(a: np.ndarray, b: np.ndarray, beta: float) -> np.ndarray:
 
 
 def neighbours(particles: list) -> list[tuple[int, int]]:
-    """Pairs of targets whose particle clouds can overlap: the MRF's edges this frame."""
-    extents = [_extent(p) for p in particles]
-    return [
-        (i, j)
-        for i in range(len(particles))
-        for j in range(i + 1, len(particles))
-        if extents[i][0] < extents[j][2] and extents[j][0] < extents[i][2]
-        and extents[i][1] < extents[j][3] and extents[j][1] < extents[i][3]
-    ]
+    """Pairs (i < j) of targets whose particle clouds can overlap: the MRF's edges this frame.
+
+    A cloud's extent is the box covering every particle's box; the extents
+    of all targets come out of one ``reduceat`` over the stacked clouds.
+    """
+    stacked = np.concatenate(particles)
+    starts = np.cumsum([0] + [len(p) for p in particles[:-1]])
+    half = stacked[:, 2:4] / 2
+    low = np.minimum.reduceat(stacked[:, :2] - half, starts)  # (M, 2): left, top
+    high = np.maximum.reduceat(stacked[:, :2] + half, starts)  # (M, 2): right, bottom
+    meet = ((low[:, None] < high[None, :]) & (low[None, :] < high[:, None])).all(axis=-1)
+    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(meet, 1)))]
 
 
-def _extent(particles: np.ndarray) -> np.ndarray:
-    """The box (left, top, right, bottom) covering every particle's box."""
-    half = particles[:, 2:4] / 2
-    return np.concatenate([(particles[:, :2] - half).min(axis=0), (particles[:, :2] + half).max(axis=0)])
-
-
-def pairwise_log_potential(states: list, beta: float) -> np.ndarray:
-    """sum over target pairs whose clouds can overlap of log phi, for aligned samples states[i][k]."""
+def pairwise_log_potential(states: list, beta: float, pairs: list | None = None) -> np.ndarray:
+    """sum over target pairs whose clouds can overlap (``pairs``, else found from ``states``) of
+    log phi, for aligned samples states[i][k]."""
     total = np.zeros(len(states[0]))
-    for i, j in neighbours(states):
+    for i, j in neighbours(states) if pairs is None else pairs:
         total += log_potential(states[i], states[j], beta)
     return total
 
@@ -79,7 +77,8 @@ def pairwise_log_potential(states: list, beta: float) -> np.ndarray:
 def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np.random.Generator) -> list:
     """The marginal posteriors W_i (eq 10) from K joint bootstrap draws weighted by the MRF (eqs 5-8, 11)."""
     draws = [multinomial(p, rng, size=k) for p in pi]  # B_i(k), eq (5)
-    log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta)  # eq (8)
+    drawn = [p[d] for p, d in zip(particles, draws)]
+    log_w = pairwise_log_potential(drawn, beta, neighbours(particles))  # eq (8); draws lie in their clouds
     w = np.exp(log_w - log_w.max())
     histograms = [np.bincount(d, weights=w, minlength=len(p)) for d, p in zip(draws, particles)]
     return [h / h.sum() for h in histograms]

@@ -18,22 +18,61 @@ is a short scalar loop over the potentials of the moved target's neighbours.
 psi is the bis_pf potential (eq 11), as for the other MRF methods.
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-from replication.filters.bis import JointFilter, JointState
+from replication.filters.bis import JointFilter, JointState, neighbours
 
 
-def _log_psi(a, b, beta: float) -> float:
-    """log psi for two boxes (cx, cy, w, h) as plain floats: bis_pf eq (11)."""
-    dx = min(a[0] + a[2] / 2, b[0] + b[2] / 2) - max(a[0] - a[2] / 2, b[0] - b[2] / 2)
-    dy = min(a[1] + a[3] / 2, b[1] + b[3] / 2) - max(a[1] - a[3] / 2, b[1] - b[3] / 2)
-    if dx <= 0 or dy <= 0:
+@njit(cache=True)
+def _log_psi(a, b, beta):
+    """log psi for two boxes (cx, cy, w, h): bis_pf eq (11).  The overlap along x is
+    (w_a + w_b) / 2 - |cx_a - cx_b|, capped by either width (one box inside the other)."""
+    ox = min((a[2] + b[2]) / 2 - abs(a[0] - b[0]), a[2], b[2])
+    oy = min((a[3] + b[3]) / 2 - abs(a[1] - b[1]), a[3], b[3])
+    if ox <= 0 or oy <= 0:
         return 0.0
-    ratio = (dx * dy) ** 2 / (a[2] * a[3] * b[2] * b[3])
+    ratio = (ox * oy) ** 2 / (a[2] * a[3] * b[2] * b[3])
     return -beta * ratio * ratio
+
+
+@njit(cache=True)
+def _chain(targets, proposals, log_like, initial, initial_like, log_uniforms, adjacent, beta):
+    """Metropolis-Hastings accept decisions, and log(likelihoods x potentials) after each step.
+
+    ``adjacent[i, j]`` marks the pairs whose boxes can overlap this frame (the
+    MRF's edges); only they enter the potential.  Compiled: the chain is
+    inherently sequential.
+    """
+    m, total = initial.shape[0], targets.shape[0]
+    current, current_like = initial.copy(), initial_like.copy()
+    pair = np.zeros((m, m))  # log psi of the current states
+    for i in range(m):
+        for j in range(m):
+            if adjacent[i, j]:
+                pair[i, j] = _log_psi(current[i], current[j], beta)
+    total_like, current_psi = current_like.sum(), pair.sum() / 2
+    accepted, score = np.zeros(total, dtype=np.bool_), np.empty(total)
+    new_pair = np.zeros(m)
+    for k in range(total):
+        i = targets[k]
+        delta_psi = 0.0
+        for j in range(m):
+            if adjacent[i, j]:
+                new_pair[j] = _log_psi(proposals[k], current[j], beta)
+                delta_psi += new_pair[j] - pair[i, j]
+        if log_like[k] > -np.inf and (current_like[i] == -np.inf or log_like[k] - current_like[i] + delta_psi >= log_uniforms[k]):
+            accepted[k] = True
+            total_like += log_like[k] - current_like[i]
+            current[i], current_like[i] = proposals[k], log_like[k]
+            current_psi += delta_psi
+            for j in range(m):
+                if adjacent[i, j]:
+                    pair[i, j] = pair[j, i] = new_pair[j]
+        score[k] = total_like + current_psi
+    return accepted, score
 
 
 @dataclass
@@ -67,28 +106,22 @@ class MCMCPF(JointFilter):
             proposals[chosen] = model.propagate(carried[i][sources[chosen]], state.t, rng)
             log_like[chosen] = model.log_likelihood(proposals[chosen], z, state.t)
         start = int(rng.integers(len(carried[0])))
-        current = [model.propagate(p[start : start + 1], state.t, rng)[0] for model, p in zip(state.models, carried)]
-        current_like = [float(model.log_likelihood(c[None], z, state.t)[0]) for model, c in zip(state.models, current)]
-        uniforms = np.log(rng.random(total))
-        kept = np.empty((self.n_particles, m, proposals.shape[1]))
-        score = np.empty(self.n_particles)  # log of likelihoods times potentials of each kept state
-        current_psi = sum(_log_psi(current[i], current[j], self.beta) for i in range(m) for j in range(i + 1, m))
-        for k in range(total):
-            i, proposal = targets[k], proposals[k]
-            delta_psi = sum(
-                _log_psi(proposal, current[j], self.beta) - _log_psi(current[i], current[j], self.beta)
-                for j in range(m)
-                if j != i
-            )
-            with np.errstate(invalid="ignore"):
-                log_ratio = log_like[k] - current_like[i] + delta_psi
-            if log_ratio >= uniforms[k] or (current_like[i] == -math.inf and log_like[k] > -math.inf):
-                current[i], current_like[i] = proposal, log_like[k]
-                current_psi += delta_psi
-            if k >= burn:
-                kept[k - burn] = current
-                score[k - burn] = sum(current_like) + current_psi
-        best = np.argsort(score)[-self.carry :]
+        initial = np.stack([model.propagate(p[start : start + 1], state.t, rng)[0] for model, p in zip(state.models, carried)])
+        initial_like = np.array([model.log_likelihood(c[None], z, state.t)[0] for model, c in zip(state.models, initial)])
+        reachable = [np.vstack([proposals[targets == i], initial[i][None]]) for i in range(m)]
+        adjacent = np.zeros((m, m), dtype=bool)
+        for i, j in neighbours(reachable):
+            adjacent[i, j] = adjacent[j, i] = True
+        accepted, score = _chain(targets, proposals, log_like, initial, initial_like, np.log(rng.random(total)), adjacent, self.beta)
+        # the state after step k holds, for each target, its last accepted proposal (or its initial state)
+        steps = np.arange(total)
+        held = np.empty((total, m), dtype=np.intp)
+        for i in range(m):
+            last = np.maximum.accumulate(np.where(accepted & (targets == i), steps, -1))
+            held[:, i] = np.where(last >= 0, last, total + i)
+        rows = np.concatenate([proposals, initial])
+        kept = rows[held[burn:]]  # (N, M, d)
+        best = np.argsort(score[burn:])[-self.carry :]
         weights = np.full(self.n_particles, 1.0 / self.n_particles)
         for i in range(m):
             state.record(i, kept[:, i], weights, False)

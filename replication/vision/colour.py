@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from replication.vision.histogram import ColourHistogram, hsv_bin_image
-from replication.vision.likelihood import bhattacharyya, gaussian_similarity_log_likelihood
+from replication.vision.likelihood import gaussian_similarity_log_likelihood
 
 
 @dataclass
@@ -29,9 +29,8 @@ class ColourLikelihood:
 
     def similarity(self, boxes: np.ndarray, bin_image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """rho of each box against the reference, and whether the box is a box with a pixel in the image."""
-        histograms = self.histogram.of_boxes(bin_image, boxes)
-        valid = (histograms.sum(axis=1) > 0) & (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
-        return bhattacharyya(histograms, self.reference), valid
+        rho, inside = self.histogram.bhattacharyya(bin_image, boxes, self.reference)
+        return rho, inside & (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
 
     def log_likelihood(self, boxes: np.ndarray, bin_image: np.ndarray) -> np.ndarray:
         rho, valid = self.similarity(boxes, bin_image)

@@ -93,19 +93,37 @@ class ColourHistogram:
         self._tiles: dict[int, np.ndarray] = {}
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-        """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height.
+        """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height."""
+        return np.vstack([
+            np.divide(counts, totals[:, None], out=np.zeros_like(counts), where=totals[:, None] > 0)
+            for counts, totals in self.counts(bin_image, boxes)
+        ])
+
+    def bhattacharyya(self, bin_image: np.ndarray, boxes: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """rho[p(box), q] for every box, and whether the box has a sample in the image.
+
+        With counts c_u and total T, rho = sum_u sqrt(c_u / T) sqrt(q_u) =
+        (sqrt(c) . sqrt(q)) / sqrt(T): no normalised (N, B) array is formed.
+        """
+        root, rho, valid = np.sqrt(reference), [], []
+        for counts, totals in self.counts(bin_image, boxes):
+            inside = totals > 0
+            rho.append(np.sqrt(counts) @ root / np.sqrt(np.where(inside, totals, 1.0)))
+            valid.append(inside)
+        return np.concatenate(rho), np.concatenate(valid)
+
+    def counts(self, bin_image: np.ndarray, boxes: np.ndarray):
+        """Kernel-weighted bin counts (n, B) and their totals (n,) over samples inside the image, by blocks of boxes.
 
         One ``cv2.remap`` (nearest neighbour) gathers the bin indices of a block
         of boxes; points outside the image read a spare bin B that is dropped;
-        one ``np.bincount`` over box-offset indices gives the block's
-        histograms.  Blocks of about ``BLOCK_SAMPLES`` sample points keep the
-        work in cache.
+        one ``np.bincount`` over box-offset indices gives the block's counts.
+        Blocks of about ``BLOCK_SAMPLES`` sample points keep the work in cache.
         """
         boxes = np.atleast_2d(np.asarray(boxes, dtype=float))
         block = max(1, BLOCK_SAMPLES // len(self.weights))
-        if len(boxes) <= block:
-            return self._block(bin_image, boxes)
-        return np.vstack([self._block(bin_image, boxes[i : i + block]) for i in range(0, len(boxes), block)])
+        for i in range(0, len(boxes), block):
+            yield self._block(bin_image, boxes[i : i + block])
 
     def _tiled(self, n: int) -> np.ndarray:
         """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
@@ -113,7 +131,7 @@ class ColourHistogram:
             self._tiles[n] = np.tile(self.weights, n)
         return self._tiles[n]
 
-    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n, spare = len(boxes), self.n_bins
         single = boxes.astype(np.float32)
         # sample k of box n sits at (cx + u_k w / 2, cy + v_k h / 2); pixel p covers [p, p + 1)
@@ -127,10 +145,9 @@ class ColourHistogram:
         if self.kernel == "diagonal":  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
             share = boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)
             u2, v2 = self.points[None, :, 0] ** 2, self.points[None, :, 1] ** 2
-            weights = (1.0 - (u2 * share + v2 * (1.0 - share))).ravel()
+            weights = 1.0 - (u2 * share + v2 * (1.0 - share))
         else:
-            weights = self._tiled(n)
-        counts = np.bincount(index.ravel(), weights=weights, minlength=n * (spare + 1))
-        histograms = counts.reshape(n, spare + 1)[:, :spare]
-        totals = histograms.sum(axis=1, keepdims=True)
-        return np.divide(histograms, totals, out=np.zeros_like(histograms), where=totals > 0)
+            weights = self._tiled(n).reshape(n, -1)
+        counts = np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * (spare + 1))
+        totals = np.where(gathered != spare, weights, 0.0).sum(axis=1)
+        return counts.reshape(n, spare + 1)[:, :spare], totals
