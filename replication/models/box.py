@@ -71,6 +71,11 @@ class BoxModel:
             self.cache.update(t=t, prepared=self.likelihood.prepare(frame))
         return self.likelihood.log_likelihood(particles[:, :4], self.cache["prepared"])
 
+    def adapt(self, estimate: np.ndarray, t: int) -> None:
+        """Let an adaptive likelihood (fusion_pf eqs 6-7) update itself at the frame's estimated state."""
+        if hasattr(self.likelihood, "adapt") and self.cache.get("t") == t:
+            self.likelihood.adapt(estimate[:4], self.cache["prepared"])
+
     @staticmethod
     def boxes(states: np.ndarray) -> np.ndarray:
         """(x, y, w, h) boxes of states (..., >= 4) given as (cx, cy, w, h, ...)."""

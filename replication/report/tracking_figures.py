@@ -19,13 +19,18 @@ def _label(experiment: dict, method: str) -> str:
 
 
 def per_frame_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition."""
+    """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition;
+    methods that do not record the series are left out."""
     groups = _by_condition(records)
     fig, axes = plt.subplots(len(groups), 1, figsize=(7, 2.6 * len(groups)), squeeze=False)
     for ax, (condition, group) in zip(axes[:, 0], groups):
         for method, runs in group.groupby("method", sort=False):
+            if spec["series"] not in runs["per_frame"].iloc[0]:  # e.g. alpha_k: fusion filters only
+                continue
             series = np.array([r[spec["series"]] for r in runs["per_frame"]], dtype=float)
             frames = np.arange(1, series.shape[1] + 1)
+            kept = ~np.isnan(series).all(axis=0)  # e.g. frame 1, given rather than estimated
+            series, frames = series[:, kept], frames[kept]
             ax.plot(frames, np.nanmean(series, axis=0), label=_label(experiment, method))
             low, high = np.nanpercentile(series, [10, 90], axis=0)
             ax.fill_between(frames, low, high, alpha=0.2)

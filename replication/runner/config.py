@@ -6,7 +6,9 @@ The ``sweep:`` block of ``model`` or of a method lists the values a parameter
 takes (``sweep: {n_particles: [500, 200, 100]}``): the runs are the product
 method x swept values x repetition.  Everything else is a parameter, lists
 included (a velocity clamp, histogram bins).  A method's ``only:`` block
-(``only: {scene: [a]}``) keeps it to the conditions with those values.  Everything is checked
+(``only: {scene: [a]}``) keeps it to the conditions with those values; its
+``observation:`` block overrides keys of ``model.observation`` (fusion_pf's two
+filters differ only there).  Everything is checked
 before any work starts, and errors are one line that names the bad key.
 """
 
@@ -144,8 +146,11 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
             raise ConfigError(f"method {method!r}: {what}; known filters: {', '.join(sorted(FILTERS))}")
         sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
         only = params.pop("only", None) or {}  # e.g. {scene: [exp1_3123]}: a method run on some conditions only
+        observation = params.pop("observation", None) or {}  # e.g. fusion_pf's colour-only filter: {alpha: 1}
         for values in itertools.product(*(values for _, _, values in sweeps)):
             run_model, run_params = dict(model), dict(params)
+            if observation:
+                run_model["observation"] = {**model.get("observation", {}), **observation}
             labels, data_labels = [], []
             for (on_model, name, _), value in zip(sweeps, values):
                 (run_model if on_model else run_params)[name] = value

@@ -6,6 +6,9 @@ A scene is declared as a dict (from Hydra config), for example::
     frames: 150
     seed: 0                          # textures, random-walk paths, camera noise
     background: {kind: clutter, colour: [60, 90, 60], like_target: 0, patches: 12}
+                                     # optional: region [left, top, right, bottom] for the patches;
+                                     # patch_structure: true and patch_rotate: degrees give them the
+                                     # target's colours in another structure
     camera_noise: 2.0                # sd of Gaussian pixel noise (grey levels)
     illumination: [{start: 40, end: 60, gain: 0.5}]
     targets:
@@ -241,10 +244,17 @@ class SyntheticScene:
         if kind == "clutter":  # patches coloured like a target: the hard case for colour-only tracking
             like = self.spec["targets"][int(spec.get("like_target", 0))]
             pw, ph = spec.get("patch_size", like["size"])
+            left, top, right, bottom = spec.get("region", (0, 0, width, height))  # where the patches lie
+            _require(0 <= left < right - pw <= width and 0 <= top < bottom - ph <= height,
+                     f"clutter region {[left, top, right, bottom]} must fit {pw}x{ph} patches inside the frame")
             for _ in range(int(spec.get("patches", 10))):
-                patch_spec = {**like, "size": [pw, ph], "structure": False, "shape": spec.get("patch_shape", "ellipse")}
+                patch_spec = {**like, "size": [pw, ph], "structure": spec.get("patch_structure", False),
+                              "shape": spec.get("patch_shape", "ellipse")}
                 patch, alpha = sprite(patch_spec, "front", rng)
-                x0, y0 = int(rng.integers(0, width - pw)), int(rng.integers(0, height - ph))
+                if spec.get("patch_rotate"):  # the target's colours in another structure (its cross turned to an X)
+                    turn = cv2.getRotationMatrix2D(((pw - 1) / 2, (ph - 1) / 2), float(spec["patch_rotate"]), 1.0)
+                    patch = cv2.warpAffine(patch, turn, (pw, ph), borderMode=cv2.BORDER_REFLECT)
+                x0, y0 = int(rng.integers(left, right - pw)), int(rng.integers(top, bottom - ph))
                 region = image[y0 : y0 + ph, x0 : x0 + pw]
                 region[:] = region * (1 - alpha[..., None]) + patch * alpha[..., None]
         return np.clip(image, 0, 255).astype(np.float32)

@@ -91,6 +91,8 @@ class ColourHistogram:
         self.points, self.weights = sample_pattern(self.kernel, tuple(self.grid), self.samples, self.rng)
         self._u, self._v = (self.points[:, i].astype(np.float32) for i in (0, 1))
         self._tiles: dict[int, np.ndarray] = {}
+        u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
+        self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height."""
@@ -144,8 +146,7 @@ class ColourHistogram:
         index += (spare + 1) * np.arange(n, dtype=np.intp)[:, None]
         if self.kernel == "diagonal":  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
             share = boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)
-            u2, v2 = self.points[None, :, 0] ** 2, self.points[None, :, 1] ** 2
-            weights = 1.0 - (u2 * share + v2 * (1.0 - share))
+            weights = self._one_minus_v2 - share * self._u2_minus_v2
         else:
             weights = self._tiled(n).reshape(n, -1)
         counts = np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * (spare + 1))
