@@ -10,7 +10,7 @@ from replication.paths import CONF_DIR, PROJECT_ROOT
 def make_cfg(tmp_path):
     """Compose a config the way the CLI does, with the store and reports in a temporary folder."""
 
-    def make(experiment="gps_qmcpf_ungm", *overrides):
+    def make(experiment="gps_qmcpf", *overrides):
         with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
             return compose(
                 "config",

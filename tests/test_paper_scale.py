@@ -11,7 +11,7 @@ from replication.runner.store import Store
 @pytest.mark.slow
 def test_bootstrap_pf_with_500_particles_is_at_the_bayes_floor(make_cfg, tmp_path):
     """100 paired runs: the PF's excess RMSE over the point-mass filter is small and not negative."""
-    cfg = make_cfg("gps_qmcpf_ungm", "scale=paper")
+    cfg = make_cfg("gps_qmcpf", "scale=paper")
     runs = expand(cfg)
     store = Store(tmp_path / "store", cfg.experiment.name)
     execute(runs, store, n_jobs=2, progress=False)

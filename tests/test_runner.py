@@ -29,15 +29,15 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
     [
         (("experiment=no_such_paper",), "unknown experiment 'no_such_paper'"),
         ((), "name an experiment"),
-        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.filter=magic"), "unknown filter 'magic'"),
-        (("experiment=gps_qmcpf_ungm", "+experiment.methods.XPF.n_particles=10"), "method 'XPF': no 'filter:' key"),
+        (("experiment=gps_qmcpf", "experiment.methods.PF.filter=magic"), "unknown filter 'magic'"),
+        (("experiment=gps_qmcpf", "+experiment.methods.XPF.n_particles=10"), "method 'XPF': no 'filter:' key"),
         (("experiment=hspf_ungm", "experiment.methods.PF.n_particles=0"), "n_particles must be a positive"),
-        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.sweep.n_particles=[100,-5]"), "at N=-5"),
-        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.sweep.n_particles=5"), "must be a non-empty list"),
-        (("experiment=gps_qmcpf_ungm", "scale=huge"), "scale must be one of"),
-        (("experiment=gps_qmcpf_ungm", "experiment.model.name=lorenz"), "unknown model 'lorenz'"),
-        (("experiment=gps_qmcpf_ungm", "experiment.model.Q=-1"), "noise variances must be positive"),
-        (("experiment=gps_qmcpf_ungm", "experiment.methods.PF.resampling=bogus"), "unknown resampling"),
+        (("experiment=gps_qmcpf", "experiment.methods.PF.sweep.n_particles=[100,-5]"), "at N=-5"),
+        (("experiment=gps_qmcpf", "experiment.methods.PF.sweep.n_particles=5"), "must be a non-empty list"),
+        (("experiment=gps_qmcpf", "scale=huge"), "scale must be one of"),
+        (("experiment=gps_qmcpf", "experiment.model.name=lorenz"), "unknown model 'lorenz'"),
+        (("experiment=gps_qmcpf", "experiment.model.Q=-1"), "noise variances must be positive"),
+        (("experiment=gps_qmcpf", "experiment.methods.PF.resampling=bogus"), "unknown resampling"),
     ],
 )
 def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):
@@ -50,12 +50,14 @@ def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):
 
 
 def test_expansion_is_method_by_condition_by_repetition(make_cfg):
-    runs = expand(make_cfg("gps_qmcpf_ungm", *SMALL))
-    assert len(runs) == (3 + 1) * 3  # PF at N = 500, 200, 100 and the grid, 3 repetitions each
-    assert {(r.method, r.condition) for r in runs} == {("PF", "N=500"), ("PF", "N=200"), ("PF", "N=100"), ("grid", "")}
+    runs = expand(make_cfg("gps_qmcpf", *SMALL))
+    assert len(runs) == (5 * 3 + 1) * 3  # five filters at N = 500, 200, 100 and the grid, 3 repetitions each
+    assert {(r.method, r.condition) for r in runs if r.method in ("PF", "grid")} == {
+        ("PF", "N=500"), ("PF", "N=200"), ("PF", "N=100"), ("grid", "")
+    }
     assert len({r.run_id for r in runs}) == len(runs)
-    paper = expand(make_cfg("gps_qmcpf_ungm"))
-    assert len(paper) == 4 * 100
+    paper = expand(make_cfg("gps_qmcpf"))
+    assert len(paper) == 16 * 100
 
 
 def test_model_sweeps_share_data_per_condition(make_cfg):
@@ -79,7 +81,7 @@ def test_seed_is_a_function_of_identity_only():
 
 
 def test_one_job_and_two_jobs_and_any_order_give_identical_records(make_cfg, tmp_path):
-    cfg = make_cfg("gps_qmcpf_ungm", *SMALL)
+    cfg = make_cfg("gps_qmcpf", *SMALL)
     runs = expand(cfg)
     frames = []
     for label, n_jobs, order in [("one", 1, runs), ("two", 2, runs), ("shuffled", 2, runs[::-1])]:
@@ -158,13 +160,13 @@ def test_interrupted_job_resumes_to_the_same_table(tmp_path):
 
 
 def test_cli_end_to_end_writes_report(cli, tmp_path):
-    result = cli("experiment=gps_qmcpf_ungm", *SMALL)
+    result = cli("experiment=gps_qmcpf", *SMALL)
     assert result.returncode == 0, result.stderr
-    assert "12 runs computed, 0 already stored" in result.stdout
-    out = tmp_path / "reports" / "gps_qmcpf_ungm"
+    assert "48 runs computed, 0 already stored" in result.stdout
+    out = tmp_path / "reports" / "gps_qmcpf"
     table = pd.read_csv(out / "table1_rmse.csv")
-    assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100", "-"]
+    assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100"] * 5 + ["-"]
     assert np.all(table["runs"] == 3)
     assert (tmp_path / "reports" / "index.html").exists()
-    again = cli("experiment=gps_qmcpf_ungm", *SMALL)
-    assert "0 runs computed, 12 already stored" in again.stdout
+    again = cli("experiment=gps_qmcpf", *SMALL)
+    assert "0 runs computed, 48 already stored" in again.stdout

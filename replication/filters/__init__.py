@@ -15,6 +15,7 @@ from replication.filters.mcmc import MCMCPF
 from replication.filters.mean_field import MFMC
 from replication.filters.point_mass import PointMassFilter
 from replication.filters.pso import pso
+from replication.filters.qmc import gps_qmcpf, nqmcpf, tr_sqmc
 
 FILTERS = {
     "bootstrap": bootstrap,
@@ -26,6 +27,12 @@ FILTERS = {
     "mfmc": MFMC,
     "dmot": DMOT,
     "mcmc": MCMCPF,
+    "nqmcpf": nqmcpf,
+    "gps_qmcpf": gps_qmcpf,
+    "tr_sqmc": tr_sqmc,
 }
 
-__all__ = ["BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter", "bootstrap", "ism", "pso"]
+__all__ = [
+    "BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter",
+    "bootstrap", "gps_qmcpf", "ism", "nqmcpf", "pso", "tr_sqmc",
+]

@@ -13,6 +13,7 @@ from omegaconf import DictConfig, OmegaConf
 import replication
 from replication.paths import resolve
 from replication.report.figures import draw
+from replication.report.qmc_figures import discrepancies
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
 from replication.report.tables import build_rating_table, build_summary_table, build_table, format_table
@@ -32,8 +33,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     tables, figures, matched, verdicts = [], [], set(), Counter()
     if len(records):
         for table_spec in spec.get("tables", []):
-            if "metrics" in table_spec:  # our numbers only, several metrics side by side
-                table = build_summary_table(records, table_spec, experiment)
+            if "metrics" in table_spec or table_spec.get("kind") == "discrepancy":  # our numbers only
+                table = (discrepancies(table_spec) if table_spec.get("kind") == "discrepancy"
+                         else build_summary_table(records, table_spec, experiment))
                 csv = f"{table_spec['name']}.csv"
                 table.to_csv(out / csv, index=False)
                 tables.append({"title": table_spec["title"], "html": html_table(table), "csv": csv})

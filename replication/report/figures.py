@@ -62,6 +62,7 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
 
 
 def _figures():
+    from replication.report.qmc_figures import point_sets
     from replication.report.tracking_figures import mode_strip, per_frame_curve, snapshots, track
 
     return {
@@ -70,6 +71,7 @@ def _figures():
         "track": track,
         "snapshots": snapshots,
         "mode_strip": mode_strip,
+        "point_sets": point_sets,
     }
 
 

@@ -13,7 +13,7 @@ import numpy as np
 Resampler = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 
 
-def _inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
+def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     """Indices i with ``C_{i-1} <= u < C_i`` for the cumulative weights C.
 
     C is divided by its last entry so that it ends at exactly 1.0 and a
@@ -26,19 +26,19 @@ def _inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
 
 def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None = None) -> np.ndarray:
     """i.i.d. draws (N, or ``size``) from the categorical distribution W (Gordon et al., 1993)."""
-    return _inverse_cdf(weights, rng.random(len(weights) if size is None else size))
+    return inverse_cdf(weights, rng.random(len(weights) if size is None else size))
 
 
 def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """One uniform in each stratum ``[k/N, (k+1)/N)`` (Kitagawa, 1996)."""
     n = len(weights)
-    return _inverse_cdf(weights, (np.arange(n) + rng.random(n)) / n)
+    return inverse_cdf(weights, (np.arange(n) + rng.random(n)) / n)
 
 
 def systematic(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """A single uniform shared by all strata: ``u_k = (k + U) / N`` (Carpenter et al., 1999)."""
     n = len(weights)
-    return _inverse_cdf(weights, (np.arange(n) + rng.random()) / n)
+    return inverse_cdf(weights, (np.arange(n) + rng.random()) / n)
 
 
 def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -55,7 +55,7 @@ def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     if n_left == 0:
         return deterministic
     remainder = scaled - copies
-    random_part = _inverse_cdf(remainder, rng.random(n_left))
+    random_part = inverse_cdf(remainder, rng.random(n_left))
     return np.concatenate([deterministic, random_part])
 
 
