@@ -9,6 +9,7 @@ targets of a run together: ``start(models, rng)`` and ``step(state, z)``.
 
 from replication.filters.bis import BISPF, MRFJPF
 from replication.filters.bootstrap import bootstrap
+from replication.filters.harmony import hs, hspf
 from replication.filters.dmot import DMOT
 from replication.filters.ism import ism
 from replication.filters.mcmc import MCMCPF
@@ -30,9 +31,11 @@ FILTERS = {
     "nqmcpf": nqmcpf,
     "gps_qmcpf": gps_qmcpf,
     "tr_sqmc": tr_sqmc,
+    "hspf": hspf,
+    "hs": hs,
 }
 
 __all__ = [
     "BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter",
-    "bootstrap", "gps_qmcpf", "ism", "nqmcpf", "pso", "tr_sqmc",
+    "bootstrap", "gps_qmcpf", "hs", "hspf", "ism", "nqmcpf", "pso", "tr_sqmc",
 ]

@@ -16,7 +16,13 @@ from replication.report.figures import draw
 from replication.report.qmc_figures import discrepancies
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
-from replication.report.tables import build_rating_table, build_summary_table, build_table, format_table
+from replication.report.tables import (
+    build_improvement_table,
+    build_rating_table,
+    build_summary_table,
+    build_table,
+    format_table,
+)
 from replication.report.verdict import RULES
 from replication.runner.config import Run, at_scale
 from replication.runner.store import Store
@@ -40,7 +46,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                 table.to_csv(out / csv, index=False)
                 tables.append({"title": table_spec["title"], "html": html_table(table), "csv": csv})
                 continue
-            build = build_rating_table if table_spec.get("kind") == "rating" else build_table
+            build = {"rating": build_rating_table, "improvement": build_improvement_table}.get(table_spec.get("kind"), build_table)
             table, hits = build(records, table_spec, experiment, published)
             if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
                 continue

@@ -154,3 +154,26 @@ def format_table(table: pd.DataFrame) -> pd.DataFrame:
     shown["paper"] = table["paper"].map(lambda v: "" if np.isnan(v) else f"{v:g}")
     shown["verdict"] = table["verdict"]
     return shown
+
+
+def build_improvement_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
+    """A paper's relative claim: 100 (metric[baseline] - metric[method]) / mean metric[baseline], paired by run.
+
+    Both methods filter the same data at a repetition, so the interval is the
+    t-interval of the paired differences, scaled by the baseline's mean.
+    """
+    metric, baseline, method = spec["metric"], spec["baseline"], spec["method"]
+    columns = ["data_condition", "repetition", metric]
+    paired = records[records["method"] == baseline][columns].merge(
+        records[records["method"] == method][columns], on=["data_condition", "repetition"], suffixes=("_base", "")
+    )
+    if paired.empty:
+        return pd.DataFrame(), set()
+    scale = 100.0 / paired[f"{metric}_base"].mean()
+    mean, low, high = (scale * v for v in mean_interval(paired[f"{metric}_base"] - paired[metric]))
+    theirs = cells(published, experiment["paper"], spec["paper_table"], spec["paper_metric"])
+    paper = float(theirs["number"].iloc[0]) if len(theirs) else np.nan
+    label = f"{experiment['methods'][method].get('label', method)} vs {experiment['methods'][baseline].get('label', baseline)}"
+    row = {"method": label, "condition": "-", "runs": len(paired), "ours": mean, "ci_low": low, "ci_high": high,
+           "paper": paper, "verdict": verdict(paper, mean, low, high, spec["paper_metric"])}
+    return pd.DataFrame([row]), set(theirs.index)
