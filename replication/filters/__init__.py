@@ -13,8 +13,10 @@ from replication.filters.harmony import hs, hspf
 from replication.filters.dmot import DMOT
 from replication.filters.ism import ism
 from replication.filters.mcmc import MCMCPF
+from replication.filters.mean_shift import ms, mspf
 from replication.filters.mean_field import MFMC
 from replication.filters.point_mass import PointMassFilter
+from replication.filters.opencv_trackers import dft, mil
 from replication.filters.pso import pso
 from replication.filters.qmc import gps_qmcpf, nqmcpf, tr_sqmc
 
@@ -33,9 +35,13 @@ FILTERS = {
     "tr_sqmc": tr_sqmc,
     "hspf": hspf,
     "hs": hs,
+    "ms": ms,
+    "mspf": mspf,
+    "mil": mil,
+    "dft": dft,
 }
 
 __all__ = [
     "BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter",
-    "bootstrap", "gps_qmcpf", "hs", "hspf", "ism", "nqmcpf", "pso", "tr_sqmc",
+    "bootstrap", "dft", "gps_qmcpf", "hs", "hspf", "ism", "mil", "ms", "mspf", "nqmcpf", "pso", "tr_sqmc",
 ]

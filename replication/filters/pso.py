@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.smc.loop import ParticleFilter, ResamplingPolicy
+from replication.filters.qmc import NQMCProposal
+from replication.smc.loop import ParticleFilter, ResamplingPolicy, prior_proposal
 
 
 @dataclass
@@ -57,6 +58,12 @@ class PSOMove:
         return x, np.zeros(len(x))
 
 
-def pso(n_particles: int, resampling: str = "systematic", ess_threshold: float = 1.0, **swarm) -> ParticleFilter:
-    """Bootstrap PF with a PSO move between prediction and weighting; ``swarm`` are :class:`PSOMove` fields."""
-    return ParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), move=PSOMove(**swarm))
+def pso(n_particles: int, resampling: str = "systematic", ess_threshold: float = 1.0, points: str | None = None,
+        **swarm) -> ParticleFilter:
+    """Bootstrap PF with a PSO move between prediction and weighting; ``swarm`` are :class:`PSOMove` fields.
+
+    ``points`` (e.g. ``good_cos``) draws the prediction's noise from that
+    randomly shifted QMC point set instead (gps_qmcpf's PSO + good point set).
+    """
+    proposal = prior_proposal if points is None else NQMCProposal(randomise=True, points=points)
+    return ParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), proposal, PSOMove(**swarm))

@@ -86,6 +86,9 @@ class _PointSource:
 class NQMCProposal(_PointSource):
     """NQMCPF: x_t^i = f(x_{t-1}^i, t) + chol(Q) Phi^-1(u_i) with QMC points u_i; weights carried over.
 
+    A model with a ``noise_factor`` W (a box model: x = A x + W e with fewer
+    noise terms than states) takes x = f(x) + W Phi^-1(u) and its ``constrain``.
+
     The paper's ref [11] (an improved QMCPF) is not available (baselines.md §6:
     "no sources found"); this is the QMC-PF of baselines.md §6 (Guo & Wang 2006;
     Ormoneit et al. 2001): the bootstrap filter with the normal draws of the
@@ -94,6 +97,10 @@ class NQMCProposal(_PointSource):
     """
 
     def __call__(self, model, particles, log_weights, t, rng):
+        factor = getattr(model, "noise_factor", None)
+        if factor is not None:  # x = A x + W Phi^-1(u), u in [0, 1)^k: rank-deficient noise (gps_qmcpf eq 14)
+            u = self.draw(len(particles), factor.shape[1], rng)
+            return model.constrain(model.f(particles, t) + ndtri(u) @ factor.T), log_weights
         u = self.uniforms(len(particles), particles.shape[1:], rng)
         return _gaussian(model.f(particles, t), model.Q, u), log_weights
 

@@ -35,6 +35,7 @@ class BoxModel:
     initial_sd: tuple[float, float, float, float] = (2.0, 2.0, 0.5, 0.5)
     min_size: float = 2.0
     cache: dict = field(default_factory=dict, repr=False)  # frame features; shared by a run's targets
+    first_frame: np.ndarray | None = field(default=None, repr=False)  # the frame of initial_box (MIL, DFT learn on it)
 
     def __post_init__(self):
         if self.kind not in MOTIONS:
@@ -46,23 +47,51 @@ class BoxModel:
             raise ValueError("noise standard deviations must be non-negative")
         self.dim = 4 if self.kind == "random_walk" else 6
 
-    def sample_initial(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        particles = np.zeros((n, self.dim))
-        particles[:, :4] = self.initial_box + self.initial_sd * rng.standard_normal((n, 4))
+    @property
+    def x0(self) -> np.ndarray:
+        """Mean of the initial state: the first box, at rest."""
+        return np.concatenate([self.initial_box, np.zeros(self.dim - 4)])
+
+    @property
+    def P0(self) -> np.ndarray:
+        """Per-coordinate variances of the initial state (velocities start at exactly 0)."""
+        return np.concatenate([self.initial_sd**2, np.zeros(self.dim - 4)])
+
+    def f(self, particles: np.ndarray, t: int) -> np.ndarray:
+        """The deterministic part A x of the motion (gps_qmcpf eq 14 for constant velocity)."""
+        if self.kind == "random_walk":
+            return particles.copy()
+        moved = particles.copy()
+        moved[:, :2] += particles[:, 4:6] * self.period
+        return moved
+
+    @property
+    def noise_factor(self) -> np.ndarray:
+        """W of x_t = A x_{t-1} + W e, e ~ N(0, I): (d, 4) (eq 14: accelerations of x and y, size steps)."""
+        if self.kind == "random_walk":
+            return np.diag(self.step_sd)
+        w = np.zeros((6, 4))
+        w[[0, 1], [0, 1]] = self.accel_sd * self.period**2 / 2
+        w[[4, 5], [0, 1]] = self.accel_sd * self.period
+        w[[2, 3], [2, 3]] = self.step_sd[2:4]
+        return w
+
+    def constrain(self, particles: np.ndarray) -> np.ndarray:
+        """Sizes are kept at least ``min_size`` px."""
         particles[:, 2:4] = np.maximum(particles[:, 2:4], self.min_size)
         return particles
 
+    def sample_initial(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        particles = np.zeros((n, self.dim))
+        particles[:, :4] = self.initial_box + self.initial_sd * rng.standard_normal((n, 4))
+        return self.constrain(particles)
+
     def propagate(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray:
-        moved = particles.copy()
-        if self.kind == "random_walk":
-            moved += self.step_sd * rng.standard_normal(particles.shape)
-        else:
-            accel = self.accel_sd * rng.standard_normal((len(particles), 2))
-            moved[:, :2] += particles[:, 4:6] * self.period + accel * self.period**2 / 2
-            moved[:, 4:6] += accel * self.period
-            moved[:, 2:4] += self.step_sd[2:4] * rng.standard_normal((len(particles), 2))
-        moved[:, 2:4] = np.maximum(moved[:, 2:4], self.min_size)
-        return moved
+        """x_t = A x_{t-1} + W e; a constant-velocity model draws the accelerations, then the size steps."""
+        n = len(particles)
+        e = rng.standard_normal((n, 4)) if self.kind == "random_walk" else np.hstack(
+            [rng.standard_normal((n, 2)), rng.standard_normal((n, 2))])
+        return self.constrain(self.f(particles, t) + e @ self.noise_factor.T)
 
     def log_likelihood(self, particles: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
         """N log-likelihoods; the frame's features are computed once per frame and reused by moves

@@ -63,7 +63,7 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
 
 def _figures():
     from replication.report.qmc_figures import point_sets
-    from replication.report.tracking_figures import mode_strip, per_frame_curve, snapshots, track
+    from replication.report.tracking_figures import mode_strip, otb_curves, per_frame_curve, snapshots, track
 
     return {
         "metric_vs_condition": metric_vs_condition,
@@ -72,6 +72,7 @@ def _figures():
         "snapshots": snapshots,
         "mode_strip": mode_strip,
         "point_sets": point_sets,
+        "otb_curves": otb_curves,
     }
 
 

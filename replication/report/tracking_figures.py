@@ -169,3 +169,32 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """OTB one-pass precision and success plots over every sequence and run, one line per method.
+
+    Each curve is the mean over runs of the per-run curve (frames after the
+    given first one), so long sequences weigh more, as in the OTB benchmark;
+    the legend gives precision at 20 px and the success AUC.
+    """
+    from replication.metrics import tracking as tm
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    for method, runs in records.groupby("method", sort=False):
+        errors = [np.asarray(r["cle"][1:], dtype=float) for r in runs["per_frame"]]
+        overlaps = [np.asarray(r["iou"][1:], dtype=float) for r in runs["per_frame"]]
+        precision = np.mean([tm.precision_curve(e) for e in errors], axis=0)
+        success = np.mean([tm.success_curve(o) for o in overlaps], axis=0)
+        label = _label(experiment, method)
+        left.plot(tm.PRECISION_THRESHOLDS, precision, label=f"{label} [{np.mean([tm.precision_at(e) for e in errors]):.3f}]")
+        right.plot(tm.SUCCESS_THRESHOLDS, success, label=f"{label} [{np.mean([tm.success_auc(o) for o in overlaps]):.3f}]")
+    left.set(xlabel="location error threshold (px)", ylabel="precision", title="Precision plot (OPE)")
+    right.set(xlabel="overlap threshold", ylabel="success rate", title="Success plot (OPE)")
+    for ax in (left, right):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

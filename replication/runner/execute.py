@@ -12,7 +12,7 @@ from replication.runner.config import Run
 from replication.runner.store import Store
 from replication.tasks import TASKS
 
-TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s")  # machine-dependent: left out of determinism checks
+TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps")  # machine-dependent: left out of determinism checks
 
 
 def perform(run: Run) -> dict:

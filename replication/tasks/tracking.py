@@ -66,12 +66,13 @@ def build_model(run: Run, sequence, target: int, cache: dict) -> BoxModel:
     x, y, w, h = sequence.truth[0, target]
     initial = np.array([x + w / 2, y + h / 2, w, h])
     histogram = ColourHistogram(**_histogram_args(observation, (w, h), run.rng(f"pattern{target}")))
+    first = sequence.frame(0)
     if observation.get("kind", "colour") == "fusion":
         fusion = {k: observation[k] for k in FUSION_KEYS if k in observation}
-        likelihood = FusionLikelihood.from_frame(sequence.frame(0), initial, histogram, observation.get("sigma", 1.0), **fusion)
+        likelihood = FusionLikelihood.from_frame(first, initial, histogram, observation.get("sigma", 1.0), **fusion)
     else:
-        likelihood = ColourLikelihood.from_frame(sequence.frame(0), initial, histogram, observation.get("sigma", 0.1))
-    return BoxModel(initial, likelihood, cache=cache, **run.model.get("motion", {}))
+        likelihood = ColourLikelihood.from_frame(first, initial, histogram, observation.get("sigma", 0.1))
+    return BoxModel(initial, likelihood, cache=cache, first_frame=first, **run.model.get("motion", {}))
 
 
 def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarray, visibility: np.ndarray) -> dict:
@@ -157,8 +158,10 @@ def run(run: Run) -> dict:
         "success_auc": float(np.mean([tm.success_auc(o) for o in overlaps[scored].T])),
         "ms_per_frame": 1000.0 * seconds / (sequence.n_frames - 1),
         "filter_s": seconds,  # the whole sequence, frame production excluded
+        "fps": (sequence.n_frames - 1) / seconds,
         "mean_ess": float(np.mean([d["mean_ess"] for d in diagnostics])),
         "resample_count": float(np.mean([d["resample_count"] for d in diagnostics])),
+        "resample_rate": float(np.mean([d["resample_rate"] for d in diagnostics])),  # % of filtered frames
         "degenerate_steps": int(sum(d["degenerate_steps"] for d in diagnostics)),
     }
     if len(chosen) > 1:
