@@ -76,3 +76,22 @@ def test_model_parameters_are_checked():
         UNGM(steps=0)
     with pytest.raises(ValueError, match="P0"):
         UNGM(P0=-1.0)
+
+
+@pytest.mark.parametrize("kind", ["random_walk", "constant_velocity"])
+def test_box_motion_is_a_x_plus_w_e(kind):
+    """propagate draws x_t = A x_{t-1} + W e: its sample mean and covariance match f and W W^T (eq 14)."""
+    from replication.models.box import BoxModel
+
+    model = BoxModel(np.array([50.0, 40.0, 20.0, 10.0]), None, kind=kind, accel_sd=0.8, period=2.0,
+                     step_sd=(3.0, 2.0, 0.4, 0.3))
+    start = np.tile(model.x0, (200_000, 1))
+    if kind == "constant_velocity":
+        start[:, 4:6] = (1.5, -0.5)
+        assert model.f(start[:1], 1)[0, :2] == pytest.approx([53.0, 39.0])  # x + v T
+    moved = model.propagate(start, 1, np.random.default_rng(0))
+    np.testing.assert_allclose(moved.mean(axis=0), model.f(start[:1], 1)[0], atol=0.02)
+    w = model.noise_factor
+    np.testing.assert_allclose(np.cov(moved.T), w @ w.T, atol=0.03)
+    if kind == "constant_velocity":  # one acceleration moves position and velocity: rank 4 in 6-D
+        assert np.linalg.matrix_rank(w @ w.T) == 4
