@@ -1,7 +1,11 @@
-"""``python -m replication.report [scale=quick] [experiment=a,b]``: rebuild reports from stored runs only.
+"""``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true]``:
+rebuild reports from stored runs only.
 
 Nothing is run: each experiment's report is redrawn from the records in the
-store, and ``reports/index.html`` links them.
+store, ``reports/index.html`` links them under the summary of every published
+cell, and ``reports/replication.pdf`` gathers the same tables and figures
+(``pdf=false`` skips it).  ``screenshot=true`` also saves headless Chromium's
+view of the index as ``reports/screenshot.png`` (where Chromium is installed).
 """
 
 import sys
@@ -15,11 +19,20 @@ from replication.runner.cli import fail
 from replication.runner.config import ConfigError, expand
 from replication.runner.store import Store
 
+SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
+
 
 def main(argv: list[str]) -> None:
     chosen = [a.split("=", 1)[1].split(",") for a in argv if a.startswith("experiment=")]
     names = chosen[-1] if chosen else experiment_names()
-    overrides = [a for a in argv if not a.startswith("experiment=")]
+    switches = dict(SWITCHES)
+    for arg in argv:
+        name, _, value = arg.partition("=")
+        if name in SWITCHES:
+            if value.lower() not in ("true", "false"):
+                fail(f"{name} must be true or false, got {value!r}")
+            switches[name] = value.lower() == "true"
+    overrides = [a for a in argv if not a.startswith("experiment=") and a.partition("=")[0] not in SWITCHES]
     unknown = sorted(set(names) - set(experiment_names()))
     if unknown:
         fail(f"unknown experiment {unknown[0]!r}; known: {', '.join(experiment_names())}")
@@ -32,7 +45,24 @@ def main(argv: list[str]) -> None:
                 fail(str(error))
             page = write_experiment_report(cfg, runs, Store(resolve(cfg.store), name))
             print(f"{name}: {page}")
-        print(f"index: {write_index(resolve(cfg.reports))}")
+        reports = resolve(cfg.reports)
+        if switches["pdf"]:
+            from replication.report.pdf import write_pdf
+
+            print(f"pdf: {write_pdf(reports, cfg.published_values)}")
+        index = write_index(reports, cfg.published_values)
+        print(f"index: {index}")
+        if switches["screenshot"]:
+            from replication.report.render import browser, open_in_browser
+
+            if browser() is None:
+                print("screenshot: skipped, no Chromium on the PATH (apt-get install chromium)",
+                      file=sys.stderr)
+            else:
+                seen = open_in_browser(index, reports / "screenshot.png")
+                print(f"screenshot: {seen['screenshot']}")
+                for line in seen["console"]:
+                    print(f"console: {line}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ from replication.report.figures import draw
 from replication.report.qmc_figures import discrepancies
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
+from replication.report.summary import matched_cells
 from replication.report.tables import (
     build_improvement_table,
     build_rating_table,
@@ -37,6 +38,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
     tables, figures, matched, verdicts = [], [], set(), Counter()
+    compared = []  # the published cells our tables matched, with our numbers: reports/index.html's summary
     if len(records):
         for table_spec in spec.get("tables", []):
             if "metrics" in table_spec or table_spec.get("kind") == "discrepancy":  # our numbers only
@@ -44,23 +46,24 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                          else build_summary_table(records, table_spec, experiment))
                 csv = f"{table_spec['name']}.csv"
                 table.to_csv(out / csv, index=False)
-                tables.append({"title": table_spec["title"], "html": html_table(table), "csv": csv})
+                tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html_table(table), "csv": csv})
                 continue
             build = {"rating": build_rating_table, "improvement": build_improvement_table}.get(table_spec.get("kind"), build_table)
             table, hits = build(records, table_spec, experiment, published)
             if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
                 continue
             matched |= hits
+            compared += matched_cells(table, hits, published, table_spec, experiment)
             verdicts.update(v.split(" (")[0] for v in table["verdict"])
             csv = f"{table_spec['name']}.csv"
             table.to_csv(out / csv, index=False)
             html = html_table(table if table_spec.get("kind") == "rating" else format_table(table))
             (out / f"{table_spec['name']}.html").write_text(html)
-            tables.append({"title": table_spec["title"], "html": html, "csv": csv})
+            tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv})
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
             draw(records, figure_spec, experiment, out / file)
-            figures.append({"title": figure_spec["title"], "file": file})
+            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file})
         records.drop(columns=["per_frame", "strip"], errors="ignore").to_csv(out / "runs.csv", index=False)
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
@@ -94,6 +97,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         "n_records": len(records),
         "n_runs": len(runs),
         "verdicts": dict(verdicts),
+        "cells": compared,
+        "tables": [{k: t[k] for k in ("name", "title", "csv")} for t in tables],
+        "figures": figures,
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     return page
