@@ -1,7 +1,25 @@
-"""Fan runs out with joblib and store each record the moment it arrives."""
+"""Fan runs out with joblib and store each record the moment it arrives.
 
+Where the runs go is ``parallel.backend`` (see ``conf/config.yaml``): ``loky``
+worker processes on this machine (the default), ``threading``, or a cluster:
+``dask`` (a ``distributed`` scheduler at ``parallel.address``, or a local
+cluster of ``n_jobs`` worker processes when no address is given) or ``ray``
+(``ray.init(address=parallel.address)``).  Wherever a run is computed, its
+record is a pure function of its identity and seed, so every backend stores
+the same numbers; only the records are sent back, and only this process
+writes the store.  Cluster workers need this package (and the same numpy,
+scipy and numba) installed; tracking runs also need the scene data at the
+same relative path.
+"""
+
+import importlib.util
+import logging
 import platform
+import sys
 import time
+import warnings
+from contextlib import contextmanager
+from typing import Iterator
 
 import numpy as np
 from joblib import Parallel, delayed, parallel_config
@@ -9,10 +27,16 @@ from tqdm.auto import tqdm
 
 import replication
 from replication.runner.config import Run
-from replication.runner.store import Store
+from replication.runner.store import Store, summarise
 from replication.tasks import TASKS
 
 TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps")  # machine-dependent: left out of determinism checks
+BACKENDS = ("loky", "threading", "dask", "ray")
+CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
+
+
+class BackendError(RuntimeError):
+    """A parallel backend that cannot be used as configured; the message is meant for the user as is."""
 
 
 def perform(run: Run) -> dict:
@@ -30,14 +54,110 @@ def perform(run: Run) -> dict:
     }
 
 
-def execute(runs: list[Run], store: Store, n_jobs: int = 2, backend: str = "loky", progress: bool = True) -> int:
+def check_backend(backend: str, address: str | None = None) -> None:
+    """Fail at once, before any work, on a backend that cannot run here (no network access)."""
+    if backend not in BACKENDS:
+        raise BackendError(f"parallel.backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
+    if address and backend not in CLUSTER_PACKAGES:
+        raise BackendError(
+            f"parallel.address is for the {' and '.join(CLUSTER_PACKAGES)} backends, "
+            f"not parallel.backend={backend}"
+        )
+    if address is not None and not isinstance(address, str):
+        raise BackendError(f"parallel.address must be a string such as tcp://host:8786; got {address!r}")
+    package = CLUSTER_PACKAGES.get(backend)
+    if package and importlib.util.find_spec(package) is None:
+        raise BackendError(f"parallel.backend={backend} needs the {package} package: pip install {package}")
+
+
+@contextmanager
+def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None = None) -> Iterator[None]:
+    """The joblib configuration for ``backend``, with its cluster connected for the duration.
+
+    ``n_jobs`` is the number of local workers (loky, threading, a local dask
+    cluster); on an existing dask or ray cluster every worker is used.
+    """
+    check_backend(backend, address)
+    if backend == "dask":
+        with _dask_client(address, n_jobs), parallel_config(backend="dask"):
+            yield
+    elif backend == "ray":
+        import ray
+        from ray.util.joblib import register_ray
+
+        register_ray()
+        started = not ray.is_initialized()
+        if started:
+            try:
+                ray.init(address=address or None, log_to_driver=False)
+            except (ConnectionError, RuntimeError, ValueError) as error:
+                where = f"ray at parallel.address={address}" if address else "ray on this machine"
+                raise BackendError(f"cannot start or reach {where}: {_one_line(error)}") from None
+        try:
+            with parallel_config(backend="ray", n_jobs=n_jobs):
+                yield
+        finally:
+            if started:
+                ray.shutdown()
+    else:
+        with parallel_config(backend=backend, n_jobs=n_jobs):
+            yield
+
+
+@contextmanager
+def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
+    from distributed import Client, LocalCluster
+
+    cluster = None
+    try:
+        if address:
+            client = Client(address)
+        else:
+            cluster = LocalCluster(
+                n_workers=n_jobs if n_jobs > 0 else None,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
+            )
+            client = Client(cluster)
+    except (OSError, TimeoutError, ValueError) as error:
+        if cluster is not None:
+            cluster.close()
+        where = f"the dask scheduler at parallel.address={address}" if address else "a local dask cluster"
+        raise BackendError(f"cannot reach {where}: {_one_line(error)}") from None
+    try:
+        yield
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _one_line(error: BaseException) -> str:
+    return " ".join(str(error).split()) or error.__class__.__name__
+
+
+def execute(
+    runs: list[Run],
+    store: Store,
+    n_jobs: int = 2,
+    backend: str = "loky",
+    progress: bool = True,
+    address: str | None = None,
+) -> int:
     """Run every run not yet stored; return how many were run.
 
     Records are written by this process as each run finishes (in any order),
     so an interrupted job loses only the runs in flight, and a rerun of the
-    same command skips everything already stored.
+    same command skips everything already stored.  Corrupt result files are
+    named in one line on stderr, set aside and run again (see :mod:`.store`).
+    A KeyboardInterrupt stops the workers and propagates, with every record
+    that arrived before it stored.
     """
-    pending = [run for run in runs if not store.has(run)]
+    pending, corrupt = store.pending(runs)
+    if corrupt:
+        print(f"re-running {len(corrupt)} corrupt result file(s): {summarise(corrupt)}", file=sys.stderr)
     if not pending:
         return 0
     by_id = {run.run_id: run for run in pending}
@@ -49,10 +169,14 @@ def execute(runs: list[Run], store: Store, n_jobs: int = 2, backend: str = "loky
         disable=not progress,
         mininterval=1.0,
     )
-    with bar, parallel_config(backend=backend, n_jobs=n_jobs):
+    with bar, parallel_backend(backend, n_jobs, address):
         results = Parallel(return_as="generator_unordered")(delayed(perform)(run) for run in pending)
-        for record in results:
-            store.write(by_id[record["run_id"]], record)
-            bar.update()
+        try:
+            for record in results:
+                store.write(by_id[record["run_id"]], record)
+                bar.update()
+        finally:
+            with warnings.catch_warnings():  # joblib warns that the generator was left unfinished: we know
+                warnings.simplefilter("ignore")
+                results.close()  # if interrupted between two records: stop the workers now
     return len(pending)
-

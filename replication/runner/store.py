@@ -5,16 +5,61 @@ The key hashes everything that can change a run's numbers (task, model and
 method parameters, base seed, package version), so a changed config lands in
 new files and is never mixed with old runs, while adding repetitions, methods
 or sweep values reuses every run already stored.
+
+Damaged records.  A record counts as stored only if it is a JSON object with
+every key of :data:`REQUIRED_KEYS` and the identity of the run whose file it is
+in (same run id, run key, method, condition, repetition, base seed).  Anything
+else -- a file truncated by a full disk or a copy, garbled bytes, a record
+moved under another run's name -- is *corrupt*: :meth:`Store.pending` renames
+it to ``<name>.json.corrupt`` (kept for inspection, ignored from then on) and
+hands the run back to be computed again, and :meth:`Store.load` leaves it out
+of every table rather than aggregate it or crash.  Temporary files of a writer
+killed mid-write (``.<random>.tmp``) are never read, and are deleted once an
+hour old.
+
+Several processes or machines on one store (a shared or network file
+system): every run is its own file, written to a unique temporary file in the
+same folder (``mkstemp``: no two writers share one) and then renamed over its
+final name (``os.replace``, atomic on local POSIX file systems and on NFS).  So
+
+* no run is lost: writers never touch each other's files, and no file is
+  ever rewritten in place, so a reader sees a whole record or none;
+* no run is duplicated: a run has exactly one file name; if two writers
+  compute the same run (both started before either finished), the second
+  rename simply replaces the first file, and since a run is a pure function
+  of its identity and seed both records agree in every column except the
+  wall-clock timings (``execute.TIMING_COLUMNS``) -- the last writer's
+  timings are kept.  (That holds for machines with the same numpy, scipy
+  and Python: the key covers this package's version only, and the records
+  carry ``numpy_version`` and ``python_version`` to show where they came from.)
+* work can be duplicated, not results: nothing locks a run while it is
+  computed, so two machines started on the same experiment at once may both
+  compute some runs.  Split the work (different experiments, methods or
+  sweep values per machine) to avoid that, or use one cluster backend.
+
+One race is benign by the same argument: a writer setting aside a file it
+read as corrupt can, in the instant between reading and renaming, move aside
+a good record another writer had just put there; the run is then computed
+once more, to the same numbers.
 """
 
 import json
 import os
+import sys
 import tempfile
+import time
 from pathlib import Path
 
 import pandas as pd
 
 from replication.runner.config import Run
+
+REQUIRED_KEYS = (  # written by execute.perform for every task
+    "experiment", "method", "condition", "data_condition", "repetition", "run_key", "run_id",
+    "base_seed", "replication_version", "wall_s",
+)
+CORRUPT_SUFFIX = ".corrupt"
+STALE_TEMPORARY_S = 3600  # a temporary file this old belongs to a writer that was killed
 
 
 class Store:
@@ -25,7 +70,70 @@ class Store:
         return self.directory / f"{_safe(run.run_id)}.json"
 
     def has(self, run: Run) -> bool:
-        return self.path(run).exists()
+        """Whether a sound record of ``run`` is stored (see :meth:`read`)."""
+        try:
+            return self.read(run) is not None
+        except CorruptRecord:
+            return False
+
+    def read(self, run: Run) -> dict | None:
+        """The stored record of ``run``; None if there is none; :class:`CorruptRecord` if it is damaged."""
+        path = self.path(run)
+        try:
+            text = path.read_text()
+        except FileNotFoundError:
+            return None
+        except (OSError, UnicodeDecodeError) as error:
+            raise CorruptRecord(path, f"unreadable ({error.__class__.__name__})") from None
+        try:
+            record = json.loads(text)
+        except ValueError:
+            raise CorruptRecord(path, "invalid JSON" if text.strip() else "empty") from None
+        if not isinstance(record, dict):
+            raise CorruptRecord(path, f"a JSON {type(record).__name__}, not an object")
+        missing = [key for key in REQUIRED_KEYS if key not in record]
+        if missing:
+            raise CorruptRecord(path, f"missing {', '.join(missing)}")
+        identity = run.identity()
+        expected = {"run_id": identity.pop("run_id"), "run_key": identity.pop("run_key"), **identity,
+                    "base_seed": run.base_seed}
+        wrong = [key for key, value in expected.items() if record[key] != value]
+        if wrong:
+            found = repr(record[wrong[0]])
+            found = found if len(found) <= 60 else found[:57] + "..."
+            raise CorruptRecord(path, f"{wrong[0]} {found} is not this file's {expected[wrong[0]]!r}")
+        return record
+
+    def pending(self, runs: list[Run]) -> tuple[list[Run], list[str]]:
+        """The runs without a sound record, and one note per corrupt file set aside on the way.
+
+        A corrupt file is renamed to ``<name>.json.corrupt`` so that its run is
+        computed again and the damaged bytes stay for inspection.
+        """
+        self._remove_stale_temporaries()
+        pending, notes = [], []
+        for run in runs:
+            try:
+                if self.read(run) is not None:
+                    continue
+            except CorruptRecord as corrupt:
+                notes.append(str(corrupt))
+                try:
+                    corrupt.path.replace(corrupt.path.with_name(corrupt.path.name + CORRUPT_SUFFIX))
+                except FileNotFoundError:
+                    pass  # another writer set it aside (or replaced it) in the meantime
+            pending.append(run)
+        return pending, notes
+
+    def _remove_stale_temporaries(self) -> None:
+        """Delete the temporaries of writers killed mid-write; a live writer's lives for milliseconds."""
+        now = time.time()
+        for tmp in self.directory.glob(".*.tmp"):
+            try:
+                if now - tmp.stat().st_mtime > STALE_TEMPORARY_S:
+                    tmp.unlink()
+            except FileNotFoundError:
+                pass
 
     def write(self, run: Run, record: dict) -> None:
         """Write ``record`` so that a crash leaves either the whole file or none of it."""
@@ -42,13 +150,41 @@ class Store:
             raise
 
     def load(self, runs: list[Run]) -> pd.DataFrame:
-        """The records of ``runs`` that are stored, one row per run."""
-        records = []
+        """The sound records of ``runs`` that are stored, one row per run.
+
+        Corrupt files are left out (never aggregated) and named in one line on
+        stderr; running the experiment again sets them aside and recomputes them.
+        """
+        records, corrupt = [], []
         for run in runs:
-            path = self.path(run)
-            if path.exists():
-                records.append(json.loads(path.read_text()))
+            try:
+                record = self.read(run)
+            except CorruptRecord as error:
+                corrupt.append(str(error))
+                continue
+            if record is not None:
+                records.append(record)
+        if corrupt:
+            print(
+                f"ignoring {len(corrupt)} corrupt result file(s) (rerun the experiment to recompute them): "
+                + summarise(corrupt),
+                file=sys.stderr,
+            )
         return pd.DataFrame.from_records(records)
+
+
+class CorruptRecord(ValueError):
+    """A stored file that is not a sound record of its run."""
+
+    def __init__(self, path: Path, reason: str):
+        super().__init__(f"{path.name} ({reason})")
+        self.path, self.reason = path, reason
+
+
+def summarise(notes: list[str], limit: int = 5) -> str:
+    """``notes`` joined on one line, the first ``limit`` of them only."""
+    shown = "; ".join(notes[:limit])
+    return shown + (f"; and {len(notes) - limit} more" if len(notes) > limit else "")
 
 
 def _safe(name: str) -> str:

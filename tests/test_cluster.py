@@ -1,0 +1,83 @@
+"""Beyond one machine: the dask backend (a local distributed cluster standing in for a real one)
+and the threading backend store the same records as loky."""
+
+import logging
+import sys
+
+import pandas as pd
+import pytest
+
+from replication.paths import PROJECT_ROOT
+from replication.runner.config import expand
+from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.store import Store
+
+TINY = ("scale=quick", "experiment.runs.quick=2")
+
+
+def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+    ) as local:
+        yield local
+
+
+def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, cluster):
+    import subprocess
+
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    loky = Store(tmp_path / "loky", "hspf_ungm")
+    assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
+    expected = deterministic_columns(loky.load(runs))
+
+    dask = Store(tmp_path / "dask", "hspf_ungm")
+    assert execute(runs, dask, backend="dask", address=cluster.scheduler_address, progress=False) == len(runs)
+    pd.testing.assert_frame_equal(deterministic_columns(dask.load(runs)), expected)
+
+    # the command line, pointed at the cluster; runs already there are not sent again
+    partial = Store(tmp_path / "cli", "hspf_ungm")
+    execute(runs[:2], partial, n_jobs=1, progress=False)
+    result = subprocess.run(
+        [
+            sys.executable, "-m", "replication", "experiment=hspf_ungm", *TINY,
+            "parallel.backend=dask", f"parallel.address={cluster.scheduler_address}",
+            f"store={tmp_path / 'cli'}", f"reports={tmp_path / 'reports'}", "progress=false",
+        ],
+        cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120,
+    )
+    assert result.returncode == 0, result.stderr
+    assert f"{len(runs) - 2} runs computed, 2 already stored" in result.stdout
+    pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
+
+
+@pytest.mark.parametrize("backend", ["threading", "dask"])
+def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, backend):
+    """threading, and dask with no address (a local cluster of n_jobs workers), against loky."""
+    if backend == "dask":
+        pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    frames = []
+    for name in ("loky", backend):
+        store = Store(tmp_path / name, "hspf_ungm")
+        assert execute(runs, store, n_jobs=2, backend=name, progress=False) == len(runs)
+        frames.append(deterministic_columns(store.load(runs)))
+    pd.testing.assert_frame_equal(frames[0], frames[1])
+
+
+def test_unreachable_scheduler_is_one_clear_error(make_cfg, tmp_path):
+    pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    import dask
+
+    from replication.runner.execute import BackendError
+
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), pytest.raises(BackendError) as error:
+        execute(runs, Store(tmp_path, "hspf_ungm"), backend="dask", address="tcp://127.0.0.1:9", progress=False)
+    assert "parallel.address=tcp://127.0.0.1:9" in str(error.value) and "\n" not in str(error.value)
+    assert not (tmp_path / "hspf_ungm").exists()

@@ -1,0 +1,228 @@
+"""Reliability of the runner: corrupt result files, interruption at any moment, concurrent writers,
+and bad configs that fail at once in one line naming the key."""
+
+import json
+import os
+import random
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from conftest import SMALL
+
+from replication.paths import PROJECT_ROOT
+from replication.runner.cli import check_overrides, prepare
+from replication.runner.config import ConfigError, expand
+from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.store import Store
+
+TINY = ("scale=quick", "experiment.runs.quick=2")
+INTERRUPTED = re.compile(r"interrupted: (\d+) runs stored, rerun the same command to resume")
+
+
+def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    """Everything in a record except wall-clock timings, sorted by run."""
+    return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
+
+
+def stored_table(store_root: Path, experiment: str) -> pd.DataFrame:
+    records = [json.loads(p.read_text()) for p in (store_root / experiment / "runs").glob("*.json")]
+    return deterministic_columns(pd.DataFrame(records))
+
+
+def command(experiment: str, store: Path, reports: Path, *args: str) -> list[str]:
+    return [
+        sys.executable, "-m", "replication", f"experiment={experiment}", *args,
+        f"store={store}", f"reports={reports}", "progress=false",
+    ]
+
+
+def test_corrupt_result_files_are_set_aside_and_rerun(make_cfg, tmp_path, capsys):
+    cfg = make_cfg("hspf_ungm", *TINY)
+    runs = expand(cfg)
+    reference = Store(tmp_path / "reference", cfg.experiment.name)
+    execute(runs, reference, n_jobs=1, progress=False)
+
+    store = Store(tmp_path / "store", cfg.experiment.name)
+    assert execute(runs, store, n_jobs=1, progress=False) == len(runs)
+    truncated, garbled, keyless, misplaced = (store.path(run) for run in runs[:4])
+    truncated.write_text(truncated.read_text()[:100])  # a full disk or an interrupted copy
+    garbled.write_bytes(os.urandom(300))
+    record = json.loads(keyless.read_text())
+    del record["run_key"], record["rmse"]
+    keyless.write_text(json.dumps(record))  # valid JSON, but not a whole record
+    misplaced.write_text(store.path(runs[5]).read_text())  # another run's record under this run's name
+    capsys.readouterr()
+
+    # the report reads around them: never aggregated, never a crash
+    partial = store.load(runs)
+    assert len(partial) == len(runs) - 4 and not set(partial["run_id"]) & {r.run_id for r in runs[:4]}
+    err = capsys.readouterr().err
+    assert err.startswith("ignoring 4 corrupt result file(s)") and len(err.strip().splitlines()) == 1
+
+    assert execute(runs, store, n_jobs=1, progress=False) == 4  # exactly the four damaged runs
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("re-running 4 corrupt result file(s): "), err
+    for path, reason in [(truncated, "invalid JSON"), (garbled, ""), (keyless, "missing run_key"),
+                         (misplaced, "run_id")]:
+        assert path.name in err and reason in err
+        assert Path(f"{path}.corrupt").exists()  # kept for inspection, out of the way
+    assert len(list(store.directory.glob("*.json"))) == len(runs)
+    expected = deterministic_columns(reference.load(runs))
+    pd.testing.assert_frame_equal(deterministic_columns(store.load(runs)), expected)
+    assert capsys.readouterr().err == ""  # nothing corrupt left
+    assert execute(runs, store, n_jobs=1, progress=False) == 0
+
+
+def test_sigint_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg, tmp_path):
+    """Ctrl-C at one random moment, SIGKILL at another, resume: the table of an uninterrupted run.
+
+    A moment is "when the k-th run has landed, plus a random delay", k and the
+    delay drawn from a seeded generator (RELIABILITY_SEED), so that on a fast or
+    a loaded machine alike the signal falls while runs are in flight.
+    """
+    rng = random.Random(int(os.environ.get("RELIABILITY_SEED", "20261121")))
+    args = ("scale=quick", "experiment.runs.quick=4", "experiment.model.sweep.steps=[10,25,50]", "n_jobs=2")
+    runs = expand(make_cfg("ungm_horizon", *args))
+    reference = Store(tmp_path / "reference", "ungm_horizon")
+    execute(runs, reference, n_jobs=1, progress=False)
+    store = tmp_path / "store"
+    runs_dir = store / "ungm_horizon" / "runs"
+    cmd = command("ungm_horizon", store, tmp_path / "reports", *args)
+
+    def stored() -> int:
+        return len(list(runs_dir.glob("*.json")))
+
+    def start_and_signal(sig: int, landed: int) -> subprocess.Popen:
+        """Start the command, wait until ``landed`` runs are stored and a random moment more, signal."""
+        process = subprocess.Popen(cmd, cwd=PROJECT_ROOT, start_new_session=True, text=True,
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        deadline = time.time() + 50
+        while stored() < landed and process.poll() is None and time.time() < deadline:
+            time.sleep(0.005)
+        time.sleep(rng.uniform(0.0, 0.1))
+        if process.poll() is None:
+            os.killpg(process.pid, sig)  # the whole group, as a terminal's Ctrl-C does
+        return process
+
+    process = start_and_signal(signal.SIGINT, landed=rng.randint(1, len(runs) // 3))
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 130, (process.returncode, err)
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    match = INTERRUPTED.fullmatch(err.strip())
+    assert match and int(match[1]) == stored(), err
+    after_sigint = stored()
+    assert 1 <= after_sigint < len(runs)
+
+    landed = rng.randint(after_sigint + 1, max(after_sigint + 1, 2 * len(runs) // 3))
+    process = start_and_signal(signal.SIGKILL, landed=landed)
+    process.communicate(timeout=60)
+    assert process.returncode == -signal.SIGKILL
+    after_sigkill = stored()
+    assert after_sigint < after_sigkill < len(runs), (after_sigint, after_sigkill, len(runs))
+
+    resumed = subprocess.run(cmd, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{len(runs) - after_sigkill} runs computed, {after_sigkill} already stored" in resumed.stdout
+    pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
+
+
+def test_two_processes_writing_one_store_leave_one_record_per_run(make_cfg, tmp_path):
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    reference = Store(tmp_path / "reference", "hspf_ungm")
+    execute(runs, reference, n_jobs=1, progress=False)
+    store = tmp_path / "shared"
+    cmd = command("hspf_ungm", store, tmp_path / "reports", *TINY, "n_jobs=1")
+    processes = [
+        subprocess.Popen(cmd, cwd=PROJECT_ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        for _ in range(2)
+    ]
+    outputs = [p.communicate(timeout=120) for p in processes]
+    for process, (out, err) in zip(processes, outputs):
+        assert process.returncode == 0, err
+    computed = [int(re.search(r"(\d+) runs computed", out)[1]) for out, _ in outputs]
+    assert sum(computed) >= len(runs)  # between them every run, some possibly twice
+    files = sorted(p.name for p in (store / "hspf_ungm" / "runs").iterdir())
+    assert files == sorted(Store(store, "hspf_ungm").path(r).name for r in runs)  # no temporaries, no duplicates
+    pd.testing.assert_frame_equal(stored_table(store, "hspf_ungm"), deterministic_columns(reference.load(runs)))
+
+
+OTB_SCENE = ("experiment=ism_pf_otb", "experiment.model.sweep.scene=[Girl]")
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("experiment=hspf_ungm", "+experiment.methods.PF.bogus=1"), "'bogus'"),
+        (("experiment=hspf_ungm", "experiment.methods.PF.n_particles=abc"),
+         "experiment.methods.PF.n_particles must be an integer, got 'abc'"),
+        (("experiment=hspf_ungm", "experiment.runs.quick=-1"), "experiment.runs.quick must be a positive integer"),
+        ((*OTB_SCENE, "+experiment.scenes.Girl.root=/no/such/otb"), "experiment.scenes.Girl.root: no folder"),
+    ],
+)
+def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args, message):
+    started = time.perf_counter()
+    result = cli(*args, "scale=quick", timeout=60)
+    elapsed = time.perf_counter() - started
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert not (tmp_path / "experiments").exists()  # no work started
+    assert elapsed < 20, elapsed  # interpreter start and imports on a loaded 2-core machine; the check is below
+
+
+@pytest.mark.parametrize(
+    "experiment, overrides, key",
+    [
+        ("hspf_ungm", ("+experiment.methods.PF.bogus=1",), "bogus"),
+        ("hspf_ungm", ("experiment.methods.PF.n_particles=abc",), "n_particles"),
+        ("gps_qmcpf", ("experiment.methods.PF.sweep.n_particles=[100,abc]",), "sweep.n_particles"),
+        ("hspf_ungm", ("experiment.runs.quick=-1",), "runs.quick"),
+        ("ism_pf_otb", ("+experiment.scenes.Girl.root=/no/such/otb",), "scenes.Girl.root"),
+        ("ism_pf_otb", ("~experiment.scenes.Girl.name",), "scenes.Girl.name"),
+        ("hspf_ungm", ("parallel.backend=spark",), "parallel.backend"),
+        ("hspf_ungm", ("parallel.address=tcp://localhost:8786",), "parallel.address"),
+        ("hspf_ungm", ("+parallel.adress=tcp://localhost:8786",), "parallel.adress"),
+        ("hspf_ungm", ("n_jobs=abc",), "n_jobs"),
+        ("hspf_ungm", ("n_jobs=0",), "n_jobs"),
+        ("hspf_ungm", ("backend=threading", "parallel.backend=dask"), "parallel.backend"),
+    ],
+)
+def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key):
+    cfg = make_cfg(experiment, "scale=quick", *overrides)
+    started = time.perf_counter()
+    with pytest.raises(ConfigError) as error:
+        prepare(cfg)
+    assert time.perf_counter() - started < 1.0
+    assert key in str(error.value) and "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["experiment=hspf_ungm", "n_job=4"], "unknown key 'n_job'"),
+        (["experiment=hspf_ungm", "experiment.methods.PF.bogus=1"], "unknown key 'experiment.methods.PF.bogus'"),
+        (["experiment=hspf_ungm", "n_jobs=[1"], "no viable alternative"),
+    ],
+)
+def test_hydra_override_errors_are_one_line(capsys, argv, message):
+    started = time.perf_counter()
+    with pytest.raises(SystemExit) as exit:
+        check_overrides(argv)
+    assert time.perf_counter() - started < 1.0
+    err = capsys.readouterr().err
+    assert exit.value.code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_every_shipped_experiment_passes_the_checks(make_cfg):
+    for experiment in ("gps_qmcpf", "ism_pf_otb", "bis_pf", "fusion_pf"):
+        runs, _, settings = prepare(make_cfg(experiment, *SMALL))
+        assert runs and settings == ("loky", 2, None)
+    # the deprecated top-level backend= is still read
+    assert prepare(make_cfg("hspf_ungm", *SMALL, "backend=threading"))[2] == ("threading", 2, None)
