@@ -224,3 +224,14 @@ def test_bad_filter_arguments_are_refused():
         gps_qmcpf(10).start(LinearGaussian(P0=0.0), np.random.default_rng(0))
     with pytest.raises(ValueError, match="scalar states"):
         SQMCProposal()(MODEL, np.zeros((4, 2)), np.zeros(4), 1, np.random.default_rng(0))
+
+
+def test_randomised_points_are_dealt_afresh_each_step():
+    """Consecutive draws give a particle unrelated points: no persistent noise direction per particle."""
+    source = NQMCProposal(randomise=True, points="halton")
+    rng = np.random.default_rng(5)
+    draws = np.array([source.draw(500, 1, rng)[:, 0] for _ in range(40)])  # (steps, particles)
+    lag_one = [np.corrcoef(draws[t], draws[t + 1])[0, 1] for t in range(39)]
+    assert abs(np.mean(lag_one)) < 0.02
+    u = np.sort(draws[0])  # still a shifted Halton set: its empirical CDF hugs the uniform one
+    assert np.max(np.abs(np.arange(1, 501) / 500 - u)) < 0.01

@@ -68,9 +68,15 @@ class _PointSource:
             raise ValueError(f"unknown point set {self.points!r}; choose one of {sorted(POINT_SETS)}")
 
     def draw(self, n: int, s: int, rng: np.random.Generator) -> np.ndarray:
-        """n points in [0, 1)^s."""
+        """n points in [0, 1)^s; randomised: shifted, and dealt to the particles in a random order.
+
+        A shift alone would give particle i the point (h_i + U_t) mod 1 at
+        every step t: its noise would stay correlated over time (the same
+        direction each step while it is not resampled), which biases the
+        filter once resampling is not done every step.
+        """
         points = point_set(self.points, n, s)
-        return random_shift(points, rng) if self.randomise else points
+        return random_shift(points, rng)[rng.permutation(n)] if self.randomise else points
 
     def uniforms(self, n: int, shape: tuple, rng: np.random.Generator) -> np.ndarray:
         """n points for states of ``shape`` (() or (d,)): an array (n, *shape)."""
