@@ -33,10 +33,11 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
         " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k not in (spec["x"], spec.get("by"))])
         for m, c in zip(summary["method"], conditions)
     ]
-    panels = list(dict.fromkeys(summary["panel"]))
+    reference = summary["x"].isna() & (summary["panel"] == "")  # e.g. the Bayes floor: drawn in every panel
+    panels = list(dict.fromkeys(summary.loc[~reference, "panel"])) or [""]
     fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4), squeeze=False)
     for ax, panel in zip(axes[0], panels):
-        rows = summary[summary["panel"] == panel]
+        rows = summary[(summary["panel"] == panel) | reference]
         for series, group in rows[rows["x"].notna()].groupby("series", sort=False):
             group = group.sort_values("x")
             if spec.get("fit_slope") and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
