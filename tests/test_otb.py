@@ -36,3 +36,17 @@ def test_real_sequences_load_with_the_published_initial_boxes():
     assert suv.n_frames == 3 and suv.frame(0).ndim == 3 and suv.frame(0).shape[2] == 3  # grey JPEG as BGR
     first, _ = find_otb(["Girl", "CarScale", "Matrix"])
     assert first == ["Girl", "CarScale"]
+
+
+@pytest.mark.skipif(not HAVE_OTB, reason="../shared/data/otb is not beside the project")
+@pytest.mark.parametrize(
+    ("name", "frames"),
+    # OTB-100's frame counts for the hspf sequences that are here (Girl: the extension)
+    [("Skating1", 400), ("Jogging-2", 307), ("David3", 252), ("CarScale", 252), ("Suv", 945), ("Girl", 500)],
+)
+def test_each_hspf_sequence_has_one_box_per_frame(name, frames):
+    sequence = OTBSequence(name)
+    assert sequence.n_frames == frames and sequence.truth.shape == (frames, 1, 4)
+    assert (sequence.truth[..., 2:] > 0).all()  # every frame has a real box
+    last = sequence.frame(frames - 1)
+    assert last.shape[:2] == (sequence.size[1], sequence.size[0])
