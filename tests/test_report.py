@@ -127,3 +127,17 @@ def test_published_values_file_has_every_ungm_cell_we_report():
     table = load_published(str(path))
     pf = table[(table["paper"] == "gps_qmcpf") & (table["method"] == "PF") & (table["metric"] == "rmse")]
     assert sorted(pf["condition"]) == ["N=100", "N=200", "N=500"]
+
+
+def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
+    from replication.report.modes import two_mode_share
+
+    density = np.zeros((4, 10))  # 10 bins over [0, 100): bin centres 5, 15, ..., 95
+    density[0, [2, 7]] = 0.5  # mass at 25 and 75: both hypotheses held
+    density[1, 2] = 1.0  # only the first
+    density[2, [2, 7]] = [0.95, 0.05]  # the second under the 10% bar
+    density[3, 5] = 1.0  # hypotheses 1 px apart: one mode, frame left out
+    hypotheses = np.array([[25.0, 75.0], [25.0, 75.0], [25.0, 75.0], [55.0, 56.0]])
+    assert two_mode_share(density, hypotheses, 100.0, width=5.0, mass=0.1) == pytest.approx(1 / 3)
+    with pytest.raises(ValueError, match="never separate"):
+        two_mode_share(density[3:], hypotheses[3:], 100.0, width=5.0, mass=0.1)

@@ -13,6 +13,7 @@ from omegaconf import DictConfig, OmegaConf
 import replication
 from replication.paths import resolve
 from replication.report.figures import draw
+from replication.report.modes import build_modes_table
 from replication.report.qmc_figures import discrepancies
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
@@ -48,7 +49,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                 table.to_csv(out / csv, index=False)
                 tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html_table(table), "csv": csv})
                 continue
-            build = {"rating": build_rating_table, "improvement": build_improvement_table}.get(table_spec.get("kind"), build_table)
+            build = {"rating": build_rating_table, "improvement": build_improvement_table,
+                     "modes": build_modes_table}.get(table_spec.get("kind"), build_table)
             table, hits = build(records, table_spec, experiment, published)
             if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
                 continue
@@ -57,7 +59,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             verdicts.update(v.split(" (")[0] for v in table["verdict"])
             csv = f"{table_spec['name']}.csv"
             table.to_csv(out / csv, index=False)
-            html = html_table(table if table_spec.get("kind") == "rating" else format_table(table))
+            html = html_table(table if table_spec.get("kind") in ("rating", "modes") else format_table(table))
             (out / f"{table_spec['name']}.html").write_text(html)
             tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv})
         for figure_spec in spec.get("figures", []):

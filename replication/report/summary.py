@@ -55,7 +55,7 @@ def matched_cells(
             chosen = theirs
         else:
             chosen = theirs[theirs["method"] == key_of.get(row["method"], row["method"])]
-            if kind == "rating":
+            if kind in ("rating", "modes"):  # text verdicts, matched by scene
                 wanted = match.get(condition, {})
                 chosen = chosen[chosen["experiment"] == wanted.get("experiment", condition)]
             else:
@@ -67,7 +67,7 @@ def matched_cells(
                     chosen = chosen[chosen["experiment"] == wanted["experiment"]]
         for index, cell in chosen.iterrows():
             used.add(index)
-            entries.append(_entry(index, cell, row, spec["name"], rating=kind == "rating"))
+            entries.append(_entry(index, cell, row, spec["name"], rating=kind in ("rating", "modes")))
     for index in sorted(set(hits) - used):  # should not happen: matched, but to no row we can tell
         entries.append({"published_index": int(index), **{k: published.at[index, k] for k in KEYS},
                         "table_name": spec["name"], "our_method": None, "our_condition": None, "runs": None,
