@@ -160,7 +160,7 @@ def test_interrupted_job_resumes_to_the_same_table(tmp_path):
 
 
 def test_cli_end_to_end_writes_report(cli, tmp_path):
-    result = cli("experiment=gps_qmcpf", *SMALL)
+    result = cli("experiment=gps_qmcpf", "experiment.also=[]", *SMALL)  # not its helicopter half
     assert result.returncode == 0, result.stderr
     assert "48 runs computed, 0 already stored" in result.stdout
     out = tmp_path / "reports" / "gps_qmcpf"
@@ -168,5 +168,15 @@ def test_cli_end_to_end_writes_report(cli, tmp_path):
     assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100"] * 5 + ["-"]
     assert np.all(table["runs"] == 3)
     assert (tmp_path / "reports" / "index.html").exists()
-    again = cli("experiment=gps_qmcpf", *SMALL)
+    again = cli("experiment=gps_qmcpf", "experiment.also=[]", *SMALL)
     assert "0 runs computed, 48 already stored" in again.stdout
+
+
+def test_a_paper_experiment_runs_its_companions_with_the_shared_settings(cli, tmp_path):
+    """``also:`` runs the paper's other half with the same scale and store, not the parent's own overrides."""
+    result = cli("experiment=hspf_ungm", "+experiment.also=[ungm_horizon]", "experiment.runs.quick=2", "scale=quick")
+    assert result.returncode == 0, result.stderr
+    assert "hspf_ungm: also ungm_horizon" in result.stdout
+    horizon = list((tmp_path / "experiments" / "ungm_horizon" / "runs").glob("*.json"))
+    per_condition = {p.name.rsplit("__r", 1)[0] for p in horizon}
+    assert len(horizon) == 20 * len(per_condition)  # its own quick scale (20 runs), not the parent's runs.quick=2

@@ -9,6 +9,7 @@ keeps every run already stored and exits with status 130 and one line.
 import inspect
 import re
 import signal
+import subprocess
 import sys
 import types
 import typing
@@ -223,10 +224,22 @@ def run_experiment(cfg: DictConfig) -> None:
 
         written = write_experiment_report(cfg, runs, store)
         print(f"{cfg.experiment.name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
+        run_companions(cfg)
     except BackendError as error:
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
+
+
+def run_companions(cfg: DictConfig) -> None:
+    """Run the experiments a paper's main one names in ``also:`` (e.g. hspf's UNGM half), with the same
+    settings except those addressed to this experiment (``experiment.*``)."""
+    shared = [a for a in sys.argv[1:] if not a.startswith(("experiment=", "experiment.", "+experiment.", "-"))]
+    for name in cfg.experiment.get("also", []) or []:
+        print(f"{cfg.experiment.name}: also {name}")
+        status = subprocess.run([sys.executable, "-m", "replication", f"experiment={name}", *shared]).returncode
+        if status:
+            raise SystemExit(status)
 
 
 def main() -> None:
