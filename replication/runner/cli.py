@@ -7,6 +7,7 @@ keeps every run already stored and exits with status 130 and one line.
 """
 
 import inspect
+import os
 import re
 import signal
 import subprocess
@@ -242,7 +243,14 @@ def run_companions(cfg: DictConfig) -> None:
             raise SystemExit(status)
 
 
+# loky's resource tracker (a child process) warns about semaphores its killed workers leaked: after a
+# Ctrl-C, or a clean stop, that is noise on the user's terminal, not a problem with the results.
+QUIET_CHILDREN = "ignore::UserWarning:joblib.externals.loky.backend.resource_tracker"
+
+
 def main() -> None:
+    if QUIET_CHILDREN not in os.environ.get("PYTHONWARNINGS", ""):
+        os.environ["PYTHONWARNINGS"] = ",".join(filter(None, [os.environ.get("PYTHONWARNINGS"), QUIET_CHILDREN]))
     try:
         argv = sys.argv[1:]
         check_experiment_argument(argv)
