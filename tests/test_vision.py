@@ -117,6 +117,18 @@ def test_ssim_hand_computed_and_identity():
     assert structural_similarity((255 - template)[None], template)[0] < 0  # inverted structure
 
 
+def test_ssim_of_a_flat_patch_against_a_textured_one_is_the_formula_s_luminance_times_constants():
+    """A constant patch has sd 0 and cov 0: contrast = C2 / (sd_y^2 + C2), structure = C3 / C3 = 1."""
+    template = rng.uniform(0, 255, (20, 20))
+    flat = np.full((20, 20), 100.0)
+    c1, c2 = (0.01 * 255) ** 2, (0.03 * 255) ** 2
+    mu, var = template.mean(), template.var()
+    expected = (2 * 100.0 * mu + c1) / (100.0**2 + mu**2 + c1) * c2 / (var + c2)
+    assert structural_similarity(flat[None], template)[0] == pytest.approx(expected)
+    assert 0 < expected < 0.05  # a flat patch says almost nothing like a textured template
+    assert structural_similarity(flat[None], flat)[0] == pytest.approx(1.0)  # two equal flat patches
+
+
 def test_patches_read_the_box_pixels():
     grey = rng.uniform(0, 255, (50, 60)).astype(np.float32)
     got, inside = patches(grey, np.array([[20 + 10, 5 + 10, 20, 20], [-100, -100, 20, 20]]), (20, 20))
