@@ -61,3 +61,13 @@ def test_weighted_mean_and_variance_hand_computed():
     # 0.25*4 + 0.5*0 + 0.25*4 = 2 in each coordinate
     np.testing.assert_allclose(weighted_variance(particles, weights), [2.0, 2.0])
     assert weighted_mean(np.array([1.0, 3.0]), np.array([0.75, 0.25])) == pytest.approx(1.5)
+
+
+def test_logsumexp_equals_scipy_along_an_axis_and_survives_underflow():
+    from scipy.special import logsumexp as scipy_logsumexp
+
+    from replication.smc.weights import logsumexp
+
+    a = np.random.default_rng(0).normal(0, 50, (7, 9)) - 2000.0  # exp(a) underflows to 0
+    for axis in (None, 0, 1):
+        np.testing.assert_allclose(logsumexp(a, axis=axis), scipy_logsumexp(a, axis=axis), rtol=1e-12)

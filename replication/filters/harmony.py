@@ -44,9 +44,9 @@ What the paper leaves open, and our reading:
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import logsumexp
 
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
+from replication.smc.weights import logsumexp
 
 COMPENSATIONS = ("printed", "importance", "none")
 MIN_VARIANCE = 1e-12  # keeps G defined when a particle set has no spread in a coordinate

@@ -24,12 +24,7 @@ from scipy.special import ndtri
 from replication.qmc import POINT_SETS, point_set, random_shift
 from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy
 from replication.smc.resampling import inverse_cdf
-
-
-def _logsumexp(a: np.ndarray, axis=None) -> np.ndarray:
-    """log sum exp(a) along ``axis`` (scipy's is several times slower on the N x N mixture)."""
-    top = np.max(a, axis=axis, keepdims=True)
-    return np.squeeze(top, axis=axis) + np.log(np.sum(np.exp(a - top), axis=axis))
+from replication.smc.weights import logsumexp
 
 
 def _gaussian(mean, cov, u: np.ndarray) -> np.ndarray:
@@ -151,14 +146,14 @@ class GoodPointSetProposal(_PointSource):
         return self._box(n, model.x0, variances, lambda x: _gaussian_log_density(x, model.x0, model.P0), rng)
 
     def __call__(self, model, particles, log_weights, t, rng):
-        log_w = log_weights - _logsumexp(log_weights)
+        log_w = log_weights - logsumexp(log_weights)
         w = np.exp(log_w)
         means = model.f(particles, t)
         mean = w @ means
         variances = w @ (means - mean) ** 2 + _variances(model.Q, particles.shape[1:])
 
         def log_predictive(x):  # eq (7)
-            return _logsumexp(log_w + model.transition_log_density(x[:, None], particles[None, :], t), axis=1)
+            return logsumexp(log_w + model.transition_log_density(x[:, None], particles[None, :], t), axis=1)
 
         return self._box(len(particles), mean, variances, log_predictive, rng)
 
