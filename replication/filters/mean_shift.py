@@ -24,7 +24,6 @@ default); Shan et al. leave the compensation open (``baselines.md`` §5 [U]).
 from dataclasses import dataclass, field
 from typing import Any
 
-import cv2
 import numpy as np
 
 from replication.filters.harmony import COMPENSATIONS, hold, log_compensation
@@ -42,16 +41,15 @@ def mean_shift(
     """Mean-shift every box (N, >= 4; cx, cy, w, h, ...) towards the reference histogram q; return the moved
     boxes (sizes unchanged) and the iterations each ran.
 
-    Per iteration one ``cv2.remap`` gathers the bins of all unconverged boxes'
-    sample points and one ``np.bincount`` gives their kernel histograms.  The
+    Per iteration one :meth:`ColourHistogram.gather` reads the bins of all unconverged boxes'
+    sample points and :meth:`ColourHistogram.tally` gives their kernel histograms.  The
     normalisation of p_u is a per-box factor that cancels in y1, so the raw
     kernel-weighted counts stand in for p_u.
     """
     if histogram.kernel != "epanechnikov":
         raise ValueError(f"mean shift needs the epanechnikov kernel (g constant), got {histogram.kernel!r}")
     boxes = np.array(boxes, dtype=float)
-    spare = histogram.n_bins  # bin read by points outside the image: w = 0
-    root_q = np.append(np.sqrt(reference), 0.0)
+    root_q = np.append(np.sqrt(reference), 0.0)  # the spare bin (points outside the image): w = 0
     u, v = histogram.points[:, 0], histogram.points[:, 1]
     iterations = np.zeros(len(boxes), dtype=int)
     active = np.flatnonzero((boxes[:, 2] > 0) & (boxes[:, 3] > 0))
@@ -59,15 +57,9 @@ def mean_shift(
         if active.size == 0:
             break
         n = active.size
-        centre, half = boxes[active, :2], boxes[active, 2:4] / 2.0
-        map_x = (centre[:, 0:1] - 0.5 + u * half[:, 0:1]).astype(np.float32)  # pixel p covers [p, p + 1)
-        map_y = (centre[:, 1:2] - 0.5 + v * half[:, 1:2]).astype(np.float32)
-        bins = cv2.remap(
-            bin_image, map_x, map_y, cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT, borderValue=spare
-        ).astype(np.intp)
-        offset = (spare + 1) * np.arange(n)[:, None]
-        kernel = np.broadcast_to(histogram.weights, bins.shape)
-        counts = np.bincount((bins + offset).ravel(), kernel.ravel(), n * (spare + 1)).reshape(n, spare + 1)
+        half = boxes[active, 2:4] / 2.0
+        bins, kernel = histogram.gather(bin_image, boxes[active])
+        counts = histogram.tally(bins, kernel)
         ratio = np.divide(root_q, np.sqrt(counts), out=np.zeros_like(counts), where=counts > 0)
         w = np.take_along_axis(ratio, bins, axis=1)
         total = w.sum(axis=1)

@@ -133,7 +133,9 @@ class ColourHistogram:
             self._tiles[n] = np.tile(self.weights, n)
         return self._tiles[n]
 
-    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def gather(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Bin index (n, K) of every sample point of ``boxes`` (n, >= 4: cx, cy, w, h), the spare bin B
+        for points outside the image, and each point's kernel weight (n, K): one ``cv2.remap``."""
         n, spare = len(boxes), self.n_bins
         single = boxes.astype(np.float32)
         # sample k of box n sits at (cx + u_k w / 2, cy + v_k h / 2); pixel p covers [p, p + 1)
@@ -142,13 +144,21 @@ class ColourHistogram:
         gathered = cv2.remap(
             bin_image, map_x, map_y, cv2.INTER_NEAREST, borderMode=cv2.BORDER_CONSTANT, borderValue=spare
         )
-        index = gathered.astype(np.intp)
-        index += (spare + 1) * np.arange(n, dtype=np.intp)[:, None]
         if self.kernel == "diagonal":  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
             share = boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)
             weights = self._one_minus_v2 - share * self._u2_minus_v2
         else:
             weights = self._tiled(n).reshape(n, -1)
-        counts = np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * (spare + 1))
-        totals = np.where(gathered != spare, weights, 0.0).sum(axis=1)
-        return counts.reshape(n, spare + 1)[:, :spare], totals
+        return gathered.astype(np.intp), weights
+
+    def tally(self, bins: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """Kernel-weighted counts (n, B + 1) of gathered ``bins`` (the last column: points outside the
+        image), one ``np.bincount`` over box-offset indices."""
+        n, width = len(bins), self.n_bins + 1
+        index = bins + width * np.arange(n, dtype=np.intp)[:, None]
+        return np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * width).reshape(n, width)
+
+    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        bins, weights = self.gather(bin_image, boxes)
+        totals = np.where(bins != self.n_bins, weights, 0.0).sum(axis=1)
+        return self.tally(bins, weights)[:, : self.n_bins], totals
