@@ -42,7 +42,7 @@ def test_fused_weight_is_the_stated_mix_of_colour_and_structure():
 
 def test_colour_only_is_the_colour_likelihood_and_skips_structure():
     model = fusion(sigma=0.1, alpha=1.0, adaptive=False)
-    colour = ColourLikelihood(model.histogram, model.reference, 0.1)
+    colour = ColourLikelihood(model.colour.histogram, model.colour.reference, 0.1)
     boxes = BOX + rng.normal(0, 5, (50, 4)) * [1, 1, 0.2, 0.2]
     prepared = model.prepare(FRAME)
     np.testing.assert_allclose(model.log_likelihood(boxes, prepared), colour.log_likelihood(boxes, prepared[0]))

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from replication.vision.histogram import ColourHistogram, hsv_bin_image
+from replication.vision.colour import ColourLikelihood
+from replication.vision.histogram import ColourHistogram
 from replication.vision.likelihood import gaussian_similarity_log_likelihood
 from replication.vision.ssim import patches, structural_similarity
 
@@ -43,8 +44,7 @@ def grey(frame: np.ndarray) -> np.ndarray:
 class FusionLikelihood:
     """p(z | box) by eq (5); ``alpha`` is alpha_k (beta_k = 1 - alpha_k), updated by :meth:`adapt`."""
 
-    histogram: ColourHistogram
-    reference: np.ndarray  # q: the first frame's colour histogram
+    colour: ColourLikelihood  # rho against q, the first frame's colour histogram (its sigma is not used)
     template: np.ndarray  # the first frame's grey square patch
     sigma: float = 1.0
     alpha: float = 0.5
@@ -60,22 +60,19 @@ class FusionLikelihood:
                    alpha: float = 0.5, adaptive: bool = True):
         """The colour reference of ``box`` (cx, cy, w, h) and the grey template of the square around its centre."""
         box = np.asarray(box, dtype=float)
-        reference = histogram.of_boxes(hsv_bin_image(frame, histogram.bins), box[None])[0]
-        if reference.sum() == 0:
-            raise ValueError("the reference box has no pixel inside the first frame")
+        colour = ColourLikelihood.from_frame(frame, box, histogram, sigma)
         if square < 2:
             raise ValueError(f"the structure template needs at least 2 px, got {square}")
         template, _ = patches(grey(frame), np.array([[box[0], box[1], square, square]]), (square, square))
-        return cls(histogram, reference, template[0], sigma, alpha, adaptive)
+        return cls(colour, template[0], sigma, alpha, adaptive)
 
     def prepare(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return hsv_bin_image(frame, self.histogram.bins), grey(frame)
+        return self.colour.prepare(frame), grey(frame)
 
     def similarities(self, boxes: np.ndarray, prepared, structure: bool = True):
         """rho (eq 3), S (eq 4; zeros when not asked for) and whether each box has a pixel in the image."""
         bin_image, grey_image = prepared
-        rho, valid = self.histogram.bhattacharyya(bin_image, boxes, self.reference)
-        valid &= (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
+        rho, valid = self.colour.similarity(boxes, bin_image)
         s = np.zeros(len(boxes))
         if structure:
             square = self.template.shape[::-1]
