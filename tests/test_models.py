@@ -37,7 +37,7 @@ def test_known_initial_state():
 def test_point_mass_filter_equals_kalman_on_linear_gaussian(P0):
     model = LinearGaussian(a=0.95, c=0.8, Q=2.0, R=0.3, x0=1.0, P0=P0, steps=40)
     observations = model.simulate(np.random.default_rng(1))[1]
-    kalman_means, kalman_variances = kalman_filter(model, observations)
+    kalman_means, kalman_variances, _ = kalman_filter(model, observations)
     means, variances = point_mass_filter(model, observations, n_points=1601, half_width=60.0)
     np.testing.assert_allclose(means, kalman_means, atol=1e-8)
     np.testing.assert_allclose(variances, kalman_variances, atol=1e-8)
@@ -95,3 +95,19 @@ def test_box_motion_is_a_x_plus_w_e(kind):
     np.testing.assert_allclose(np.cov(moved.T), w @ w.T, atol=0.03)
     if kind == "constant_velocity":  # one acceleration moves position and velocity: rank 4 in 6-D
         assert np.linalg.matrix_rank(w @ w.T) == 4
+
+
+def test_kalman_log_evidence_is_the_joint_gaussian_density_of_the_observations():
+    """z_1..z_T is jointly Gaussian: mean c a^t x0, Cov[z_t, z_u] = c^2 Cov[x_t, x_u] + R [t = u]."""
+    from scipy.stats import multivariate_normal
+
+    model = LinearGaussian(a=0.8, c=1.5, Q=2.0, R=0.5, x0=0.3, P0=1.2, steps=6)
+    observations = model.simulate(np.random.default_rng(3))[1]
+    t = np.arange(1, model.steps + 1)
+    lag = np.minimum.outer(t, t)
+    cov_x = model.a ** np.add.outer(t, t) * model.P0 + model.Q * sum(
+        model.a ** (np.add.outer(t, t) - 2 * s) * (lag >= s) for s in range(1, model.steps + 1)
+    )
+    cov_z = model.c**2 * cov_x + model.R * np.eye(model.steps)
+    exact = multivariate_normal(model.c * model.a**t * model.x0, cov_z).logpdf(observations)
+    assert kalman_filter(model, observations)[2] == pytest.approx(exact, rel=1e-10)

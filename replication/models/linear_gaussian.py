@@ -21,13 +21,16 @@ class LinearGaussian(AdditiveGaussianModel):
         return self.c * x
 
 
-def kalman_filter(model: LinearGaussian, observations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Posterior means and variances of x_t given z_1..z_t (Kalman, 1960)."""
-    mean, var = model.x0, model.P0
+def kalman_filter(model: LinearGaussian, observations: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Posterior means and variances of x_t given z_1..z_t (Kalman, 1960), and the log marginal
+    likelihood log p(z_1..z_T) = sum_t log N(z_t; c m_t|t-1, c^2 P_t|t-1 + R)."""
+    mean, var, log_evidence = model.x0, model.P0, 0.0
     means, variances = np.empty(len(observations)), np.empty(len(observations))
     for k, z in enumerate(observations):
         mean, var = model.a * mean, model.a**2 * var + model.Q
-        gain = var * model.c / (model.c**2 * var + model.R)
+        s = model.c**2 * var + model.R
+        log_evidence += -0.5 * (np.log(2.0 * np.pi * s) + (z - model.c * mean) ** 2 / s)
+        gain = var * model.c / s
         mean, var = mean + gain * (z - model.c * mean), (1.0 - gain * model.c) * var
         means[k], variances[k] = mean, var
-    return means, variances
+    return means, variances, float(log_evidence)
