@@ -180,3 +180,14 @@ def test_a_paper_experiment_runs_its_companions_with_the_shared_settings(cli, tm
     horizon = list((tmp_path / "experiments" / "ungm_horizon" / "runs").glob("*.json"))
     per_condition = {p.name.rsplit("__r", 1)[0] for p in horizon}
     assert len(horizon) == 20 * len(per_condition)  # its own quick scale (20 runs), not the parent's runs.quick=2
+
+
+def test_workers_keep_freed_memory_on_glibc():
+    """The allocator setting every run starts with (replication.runner.memory) takes on glibc Linux."""
+    import platform
+
+    from replication.runner.memory import retain_freed_memory
+
+    if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
+        pytest.skip("mallopt thresholds are glibc's")
+    assert retain_freed_memory() is True

@@ -27,6 +27,7 @@ from tqdm.auto import tqdm
 
 import replication
 from replication.runner.config import Run
+from replication.runner.memory import retain_freed_memory
 from replication.runner.store import Store, summarise
 from replication.tasks import TASKS
 
@@ -41,6 +42,7 @@ class BackendError(RuntimeError):
 
 def perform(run: Run) -> dict:
     """One run: a pure function of the run's identity, parameters and seed."""
+    retain_freed_memory()  # in whichever process computes it: a worker of any backend
     started = time.perf_counter()
     metrics = TASKS[run.task].run(run)
     return {

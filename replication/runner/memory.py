@@ -1,0 +1,32 @@
+"""Keep freed memory in the process instead of handing it back to the OS at every ``free``.
+
+A filter step allocates the same large temporaries every frame (an (N, B + 1)
+count table per likelihood call, an N x N potential table per MRF pair).
+glibc serves blocks over its mmap threshold (128 kB at first) with fresh
+``mmap`` pages and trims the heap's free top back to the OS, so each frame
+page-faults those arrays in again; in this machine's VM that made the bis_pf
+runs 2-3 times slower (see the README's "Speed").  Raising both thresholds
+(``mallopt``, M_MMAP_THRESHOLD and M_TRIM_THRESHOLD: the same effect as the
+``MALLOC_MMAP_THRESHOLD_`` and ``MALLOC_TRIM_THRESHOLD_`` environment
+variables, but settable after start, in any worker) lets the heap reuse them.
+The numbers computed do not change.  No effect off glibc.
+"""
+
+import ctypes
+import ctypes.util
+from functools import cache
+
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
+MMAP_THRESHOLD = 32 * 2**20  # glibc's maximum on 64-bit: blocks above it still get their own mapping
+TRIM_THRESHOLD = 256 * 2**20  # at most this much free memory is kept at the heap's top
+
+
+@cache
+def retain_freed_memory() -> bool:
+    """Set the two glibc thresholds for this process (once); whether it took effect."""
+    name = ctypes.util.find_library("c")
+    try:
+        mallopt = ctypes.CDLL(name).mallopt
+    except (OSError, AttributeError, TypeError):  # not glibc (macOS, musl without mallopt, Windows)
+        return False
+    return bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD))
