@@ -105,27 +105,35 @@ class ColourHistogram:
         """rho[p(box), q] for every box, and whether the box has a sample in the image.
 
         With counts c_u and total T, rho = sum_u sqrt(c_u / T) sqrt(q_u) =
-        (sqrt(c) . sqrt(q)) / sqrt(T): no normalised (N, B) array is formed.
+        (sqrt(c) . sqrt(q)) / sqrt(T): no normalised (N, B) array is formed, and
+        the square root is taken in place over the tally, whose spare column
+        (points outside the image) meets a zero in sqrt(q).
         """
-        root, rho, valid = np.sqrt(reference), [], []
-        for counts, totals in self.counts(bin_image, boxes):
+        root, rho, valid = np.append(np.sqrt(reference), 0.0), [], []
+        for table, totals in self._tables(bin_image, boxes):
             inside = totals > 0
-            rho.append(np.sqrt(counts) @ root / np.sqrt(np.where(inside, totals, 1.0)))
+            rho.append(np.sqrt(table, out=table) @ root / np.sqrt(np.where(inside, totals, 1.0)))
             valid.append(inside)
         return np.concatenate(rho), np.concatenate(valid)
 
     def counts(self, bin_image: np.ndarray, boxes: np.ndarray):
-        """Kernel-weighted bin counts (n, B) and their totals (n,) over samples inside the image, by blocks of boxes.
+        """Kernel-weighted bin counts (n, B) and their totals (n,) over samples inside the image, by blocks of boxes."""
+        for table, totals in self._tables(bin_image, boxes):
+            yield table[:, : self.n_bins], totals
+
+    def _tables(self, bin_image: np.ndarray, boxes: np.ndarray):
+        """Tallies (n, B + 1) and totals inside the image (n,), by blocks of boxes.
 
         One ``cv2.remap`` (nearest neighbour) gathers the bin indices of a block
-        of boxes; points outside the image read a spare bin B that is dropped;
-        one ``np.bincount`` over box-offset indices gives the block's counts.
+        of boxes; points outside the image read a spare bin B; one
+        ``np.bincount`` over box-offset indices gives the block's tallies.
         Blocks of about ``BLOCK_SAMPLES`` sample points keep the work in cache.
         """
         boxes = np.atleast_2d(np.asarray(boxes, dtype=float))
         block = max(1, BLOCK_SAMPLES // len(self.weights))
         for i in range(0, len(boxes), block):
-            yield self._block(bin_image, boxes[i : i + block])
+            bins, weights = self.gather(bin_image, boxes[i : i + block])
+            yield self.tally(bins, weights), np.where(bins != self.n_bins, weights, 0.0).sum(axis=1)
 
     def _tiled(self, n: int) -> np.ndarray:
         """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
@@ -157,8 +165,3 @@ class ColourHistogram:
         n, width = len(bins), self.n_bins + 1
         index = bins + width * np.arange(n, dtype=np.intp)[:, None]
         return np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * width).reshape(n, width)
-
-    def _block(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        bins, weights = self.gather(bin_image, boxes)
-        totals = np.where(bins != self.n_bins, weights, 0.0).sum(axis=1)
-        return self.tally(bins, weights)[:, : self.n_bins], totals
