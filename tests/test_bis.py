@@ -112,6 +112,25 @@ def test_mean_field_one_iteration_by_hand():
     np.testing.assert_allclose(MFMC(n_particles=2, iterations=5).interact(far, pi, _state(2))[0], pi[0])
 
 
+def test_mean_field_blocks_equal_the_full_tables():
+    """Only particles that reach the other cloud get a block of log psi; the fixed point is the full-table one."""
+    from replication.filters.mean_field import MFMC
+
+    rng = np.random.default_rng(3)
+    centres = [(20.0, 20.0), (34.0, 22.0), (30.0, 40.0), (120.0, 120.0)]  # three interacting, one apart
+    clouds = [np.column_stack([rng.normal(c, 6.0, (50, 2)), np.full((50, 2), 10.0)]) for c in centres]
+    pi = [w / w.sum() for w in rng.random((4, 50))]
+    q_full = list(pi)
+    for _ in range(3):
+        field = [sum(log_potential(clouds[i][:, None], clouds[j][None, :], 4.0) @ q_full[j] for j in range(4) if j != i)
+                 for i in range(4)]
+        q_full = [p * np.exp(f) / (p * np.exp(f)).sum() for p, f in zip(pi, field)]
+    q = MFMC(n_particles=50, iterations=3, beta=4.0).interact(clouds, pi, _state(4))
+    for mine, full in zip(q, q_full):
+        np.testing.assert_allclose(mine, full, rtol=1e-12)
+    assert not np.allclose(q[0], pi[0]) and np.allclose(q[3], pi[3])  # the interaction did act, and only on neighbours
+
+
 def test_dmot_repels_particles_from_a_neighbours_estimate():
     from replication.filters.dmot import DMOT
 

@@ -50,19 +50,26 @@ def log_potential(a: np.ndarray, b: np.ndarray, beta: float) -> np.ndarray:
     return -beta * ratio**2
 
 
-def neighbours(particles: list) -> list[tuple[int, int]]:
-    """Pairs (i < j) of targets whose particle clouds can overlap: the MRF's edges this frame.
-
-    A cloud's extent is the box covering every particle's box; the extents
-    of all targets come out of one ``reduceat`` over the stacked clouds.
-    """
+def cloud_extents(particles: list) -> tuple[np.ndarray, np.ndarray]:
+    """Each target's cloud extent, the box covering every particle's box: (M, 2) left-top and
+    right-bottom corners, from one ``reduceat`` over the stacked clouds."""
     stacked = np.concatenate(particles)
     starts = np.cumsum([0] + [len(p) for p in particles[:-1]])
     half = stacked[:, 2:4] / 2
-    low = np.minimum.reduceat(stacked[:, :2] - half, starts)  # (M, 2): left, top
-    high = np.maximum.reduceat(stacked[:, :2] + half, starts)  # (M, 2): right, bottom
+    return np.minimum.reduceat(stacked[:, :2] - half, starts), np.maximum.reduceat(stacked[:, :2] + half, starts)
+
+
+def neighbours(particles: list) -> list[tuple[int, int]]:
+    """Pairs (i < j) of targets whose particle clouds can overlap: the MRF's edges this frame."""
+    low, high = cloud_extents(particles)
     meet = ((low[:, None] < high[None, :]) & (low[None, :] < high[:, None])).all(axis=-1)
     return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(meet, 1)))]
+
+
+def reaching(boxes: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Indices of the ``boxes`` that meet the extent [low, high]: the only ones another cloud can touch."""
+    half = boxes[:, 2:4] / 2
+    return np.flatnonzero(((boxes[:, :2] - half < high) & (boxes[:, :2] + half > low)).all(axis=1))
 
 
 def pairwise_log_potential(states: list, beta: float, pairs: list | None = None) -> np.ndarray:

@@ -120,9 +120,9 @@ class MCMCPF(JointFilter):
             last = np.maximum.accumulate(np.where(accepted & (targets == i), steps, -1))
             held[:, i] = np.where(last >= 0, last, total + i)
         rows = np.concatenate([proposals, initial])
-        kept = rows[held[burn:]]  # (N, M, d)
+        kept = rows[held[burn:].T]  # (M, N, d): each target's samples contiguous
         best = np.argsort(score[burn:])[-self.carry :]
         weights = np.full(self.n_particles, 1.0 / self.n_particles)
         for i in range(m):
-            state.record(i, kept[:, i], weights, False)
-        state.carried = [kept[best, i] for i in range(m)]
+            state.record(i, kept[i], weights, False)
+        state.carried = [kept[i, best] for i in range(m)]

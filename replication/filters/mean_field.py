@@ -7,14 +7,16 @@ once (Jacobi):
     q_i(n) ∝ pi_i(n) exp( sum_{j in Γ(i)} sum_m q_j(m) log psi(x_i^n, x_j^m) ),
 
 starting from q_i = pi_i, with psi the bis_pf potential (eq 11) so that the
-MRF methods differ only in inference.  Γ(i): targets whose clouds can overlap.
+MRF methods differ only in inference.  Γ(i): targets whose clouds can overlap.  A pair's N x N table of log psi is
+zero outside the particles of i that reach j's cloud and those of j that reach
+i's, so only that block is formed.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from replication.filters.bis import DistributedFilter, JointState, log_potential, neighbours
+from replication.filters.bis import DistributedFilter, JointState, cloud_extents, log_potential, neighbours, reaching
 from replication.smc.weights import normalise
 
 
@@ -29,15 +31,18 @@ class MFMC(DistributedFilter):
             raise ValueError(f"need N > 0, iterations >= 0, beta >= 0; got {self}")
 
     def interact(self, particles: list, pi: list, state: JointState) -> list:
-        edges = neighbours(particles)
-        log_psi = {(i, j): log_potential(particles[i][:, None], particles[j][None, :], self.beta) for i, j in edges}
+        low, high = cloud_extents(particles)
+        blocks = {}  # (i, j) -> (rows of i, columns of j, log psi between them)
+        for i, j in neighbours(particles):
+            rows, cols = reaching(particles[i], low[j], high[j]), reaching(particles[j], low[i], high[i])
+            blocks[i, j] = rows, cols, log_potential(particles[i][rows, None], particles[j][None, cols], self.beta)
         with np.errstate(divide="ignore"):
             log_pi = [np.log(p) for p in pi]
         q = list(pi)
         for _ in range(self.iterations):
             field = [np.zeros(len(p)) for p in pi]
-            for (i, j), table in log_psi.items():  # expected log-potential under the other target's q
-                field[i] += table @ q[j]
-                field[j] += table.T @ q[i]
+            for (i, j), (rows, cols, table) in blocks.items():  # expected log-potential under the other's q
+                field[i][rows] += table @ q[j][cols]
+                field[j][cols] += table.T @ q[i][rows]
             q = [normalise(lp + f)[0] for lp, f in zip(log_pi, field)]
         return q
