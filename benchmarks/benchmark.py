@@ -29,6 +29,7 @@ from replication.models import UNGM  # noqa: E402
 from replication.paths import resolve  # noqa: E402
 from replication.report.index import write_index  # noqa: E402
 from replication.report.render import html_table, render  # noqa: E402
+from replication.runner.memory import retain_freed_memory  # noqa: E402
 from replication.scenes import SyntheticScene  # noqa: E402
 from replication.smc.resampling import RESAMPLERS  # noqa: E402
 from replication.vision.colour import ColourLikelihood  # noqa: E402
@@ -178,6 +179,7 @@ def _loglog(table, x, y, group, path, ylabel):
 
 
 def main() -> None:
+    retain_freed_memory()  # as every experiment's run does
     out = resolve("reports") / "benchmark"
     out.mkdir(parents=True, exist_ok=True)
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
@@ -191,9 +193,12 @@ def main() -> None:
     _loglog(core, "N", "us_per_call", "what", out / "smc_core.png", "µs per call (best of repeats)")
     (out / "index.html").write_text(
         render(
-            "benchmark.html.j2",
+            "sections.html.j2",
             title="Benchmark: cost of the likelihood, the SMC core and scene rendering",
-            machine=f"{platform.machine()}, Python {platform.python_version()}, numpy {np.__version__}, OpenCV {cv2.__version__}",
+            up="../index.html",
+            up_label="all experiments",
+            meta=f"Machine: {platform.machine()}, Python {platform.python_version()}, numpy {np.__version__}, "
+            f"OpenCV {cv2.__version__}. Best of several calls, single process. Made by make benchmark.",
             sections=[
                 {"title": "Colour likelihood throughput (480x410 frame, 40x40 boxes, 8x8x4 bins)",
                  "figure": "likelihood.png", "table": html_table(likelihood.round(5))},

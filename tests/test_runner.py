@@ -191,3 +191,31 @@ def test_workers_keep_freed_memory_on_glibc():
     if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
         pytest.skip("mallopt thresholds are glibc's")
     assert retain_freed_memory() is True
+
+
+def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_path):
+    """``-m key=a,b`` stores every value's runs (shared runs once); ``replication.report sweep=`` reads them back."""
+    settings = ["scale=quick", "experiment.runs.quick=3", "experiment.model.sweep.steps=[10]"]
+    result = cli("-m", "experiment=ungm_horizon", *settings, "experiment.methods.grid.n_points=201,1601")
+    assert result.returncode == 0, result.stderr
+    assert "9 runs computed, 0 already stored" in result.stdout and "3 runs computed, 6 already stored" in result.stdout
+    report = subprocess.run(
+        [sys.executable, "-m", "replication.report", "experiment=ungm_horizon", *settings, f"store={tmp_path / 'experiments'}",
+         f"reports={tmp_path / 'reports'}", "sweep=experiment.methods.grid.n_points=201,1601,3201", "metric=rmse"],
+        cwd=PROJECT_ROOT, capture_output=True, text=True,
+    )
+    assert report.returncode == 0, report.stderr
+    assert "n_points=3201: 3 of 9 runs not stored" in report.stderr  # a value never run is named, not drawn
+    out = tmp_path / "reports" / "ungm_horizon" / "sweeps"
+    table = pd.read_csv(out / "experiment.methods.grid.n_points.csv").set_index("condition")
+    records = pd.DataFrame([json.loads(p.read_text()) for p in (tmp_path / "experiments" / "ungm_horizon" / "runs").glob("*.json")])
+    grid = records[records["method"] == "grid"]  # two configs, 3 runs each
+    assert len(grid) == 6 and set(table.index) == {"T=10;n_points=201", "T=10;n_points=1601", "T=10;N=100", "T=10;N=500"}
+    assert sorted(table.loc[["T=10;n_points=201", "T=10;n_points=1601"], "mean"]) == pytest.approx(
+        sorted(grid.groupby("run_key")["rmse"].mean()))
+    assert table.loc["T=10;N=500", "runs"] == 3  # PF does not depend on the grid: once, as a reference line
+    assert (out / "experiment.methods.grid.n_points.png").stat().st_size > 10_000
+    bad = subprocess.run([sys.executable, "-m", "replication.report", "experiment=ungm_horizon", *settings,
+                          f"store={tmp_path / 'experiments'}", "sweep=experiment.methods.grid.n_points=201", "metric=nope"],
+                         cwd=PROJECT_ROOT, capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "metric 'nope'" in bad.stderr

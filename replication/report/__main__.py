@@ -1,6 +1,9 @@
 """``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true]``:
 rebuild reports from stored runs only.
 
+``python -m replication.report experiment=<name> sweep=<key>=v1,v2,... [metric=<column>]``
+instead draws a Hydra multirun's sweep of one config value (``replication.report.sweep``).
+
 Nothing is run: each experiment's report is redrawn from the records in the
 store, ``reports/index.html`` links them under the summary of every published
 cell, and ``reports/replication.pdf`` gathers the same tables and figures
@@ -20,6 +23,7 @@ from replication.runner.config import ConfigError, expand
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
+OPTIONS = ("sweep", "metric")  # ours too: name=text
 
 
 def main(argv: list[str]) -> None:
@@ -32,10 +36,17 @@ def main(argv: list[str]) -> None:
             if value.lower() not in ("true", "false"):
                 fail(f"{name} must be true or false, got {value!r}")
             switches[name] = value.lower() == "true"
-    overrides = [a for a in argv if not a.startswith("experiment=") and a.partition("=")[0] not in SWITCHES]
+    options = {a.partition("=")[0]: a.partition("=")[2] for a in argv if a.partition("=")[0] in OPTIONS}
+    overrides = [a for a in argv if not a.startswith("experiment=") and a.partition("=")[0] not in (*SWITCHES, *OPTIONS)]
     unknown = sorted(set(names) - set(experiment_names()))
     if unknown:
         fail(f"unknown experiment {unknown[0]!r}; known: {', '.join(experiment_names())}")
+    if "sweep" in options:
+        if len(names) != 1:
+            fail("sweep= needs one experiment=<name>: the one the multirun ran")
+        return report_sweep(names[0], options["sweep"], options.get("metric"), overrides)
+    if "metric" in options:
+        fail("metric= only goes with sweep=")
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         for name in names:
             cfg = compose("config", overrides=[f"experiment={name}", *overrides])
@@ -63,6 +74,39 @@ def main(argv: list[str]) -> None:
                 print(f"screenshot: {seen['screenshot']}")
                 for line in seen["console"]:
                     print(f"console: {line}", file=sys.stderr)
+
+
+def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]) -> None:
+    from hydra.errors import HydraException
+    from omegaconf import OmegaConf
+    from omegaconf.errors import OmegaConfBaseException
+
+    from replication.report.sweep import default_metric, parse_sweep, sweep_records, write_sweep_report
+    from replication.runner.config import at_scale
+
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        try:
+            key, values = parse_sweep(sweep)
+            records, missing = sweep_records(
+                key, values,
+                compose=lambda extra: compose("config", overrides=[f"experiment={name}", *overrides, *extra]),
+                expand=expand,
+                load=lambda cfg, runs: Store(resolve(cfg.store), name).load(runs),
+            )
+            cfg = compose("config", overrides=[f"experiment={name}", *overrides])
+            experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale)
+            if records.empty:
+                fail(f"{name}: no stored runs for any value of {key}; run the multirun first: "
+                     f"python -m replication -m experiment={name} {' '.join(overrides)} {sweep}")
+            command = " ".join(["python -m replication.report", f"experiment={name}", *overrides, f"sweep={sweep}"]
+                               + ([f"metric={metric}"] if metric else []))
+            page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
+                                      resolve(cfg.reports) / name / "sweeps", missing, command)
+        except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
+            fail(str(error).splitlines()[0])
+    for line in missing:
+        print(f"missing: {line}", file=sys.stderr)
+    print(f"sweep: {page}")
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
     ``by`` (a swept variable) splits the figure into one panel per value;
+    x is on a log scale unless ``log_x: false``;
     ``fit_slope`` adds each series' log-log slope to its label.  A
     method that does not sweep ``x`` (the point-mass reference, say) is drawn
     as a horizontal band.
@@ -48,7 +49,8 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
         for _, row in rows[rows["x"].isna()].iterrows():
             line = ax.axhline(row["mean"], linestyle="--", color="k", label=row["series"])
             ax.axhspan(row["ci_low"], row["ci_high"], color=line.get_color(), alpha=0.1)
-        ax.set_xscale("log")
+        if spec.get("log_x", True):
+            ax.set_xscale("log")
         if spec.get("log_y"):
             ax.set_yscale("log")
         ax.set_xlabel(spec["x"])
