@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 from replication.scenes import OTBSequence, SyntheticScene
-from replication.scenes import factory
 from replication.scenes.export import write_sequence
 from replication.scenes.synthetic import SceneError, trajectory
 
@@ -60,26 +59,6 @@ def test_same_seed_same_frames_in_any_order():
     other = SyntheticScene({**spec, "seed": 6})
     assert not np.array_equal(other.frame(0), forwards[0])
     assert not np.array_equal(forwards[0], forwards[1])  # camera noise differs from frame to frame
-
-
-def test_kept_frames_equal_rendered_ones_and_respect_the_budget(monkeypatch):
-    spec = {"size": [64, 48], "frames": 6, "seed": 7, "camera_noise": 3.0, "background": {"kind": "noise", "colour": GREY},
-            "targets": [{"shape": "ball", "size": [10, 10], "colour": [20, 200, 20],
-                         "motion": {"kind": "random_walk", "noise_var": 0.4, "max_speed": 2}}]}
-    frame_bytes = 64 * 48 * 3
-    monkeypatch.setattr(factory.KeptFrames, "_frames", factory.OrderedDict())
-    monkeypatch.setattr(factory.KeptFrames, "_bytes", 0)
-    monkeypatch.setattr(factory, "FRAME_CACHE_BYTES", 4 * frame_bytes)
-    kept, fresh = factory.cached_sequence(spec), SyntheticScene(spec)
-    assert factory.cached_sequence(spec) is kept and kept.truth is kept.sequence.truth
-    first = [kept.frame(k) for k in range(6)]
-    for k in range(6):
-        np.testing.assert_array_equal(kept.frame(k), fresh.frame(k))
-    last = kept.frame(5)
-    assert kept.frame(5) is last  # read back, not rendered again
-    assert factory.KeptFrames._bytes == 4 * frame_bytes and len(factory.KeptFrames._frames) == 4  # oldest dropped
-    with pytest.raises(ValueError):
-        last[0, 0] = 0  # shared with later readers: read-only
 
 
 def test_occluder_visibility_half_and_complete():
