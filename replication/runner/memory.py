@@ -18,7 +18,7 @@ from functools import cache
 
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
 MMAP_THRESHOLD = 32 * 2**20  # glibc's maximum on 64-bit: blocks above it still get their own mapping
-TRIM_THRESHOLD = 256 * 2**20  # at most this much free memory is kept at the heap's top
+TRIM_THRESHOLD = 64 * 2**20  # at most this much free memory is kept at the heap's top (loky restarts a worker grown by 300 MB)
 
 
 @cache
