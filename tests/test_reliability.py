@@ -191,7 +191,6 @@ def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args
         ("hspf_ungm", ("+parallel.adress=tcp://localhost:8786",), "parallel.adress"),
         ("hspf_ungm", ("n_jobs=abc",), "n_jobs"),
         ("hspf_ungm", ("n_jobs=0",), "n_jobs"),
-        ("hspf_ungm", ("backend=threading", "parallel.backend=dask"), "parallel.backend"),
     ],
 )
 def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key):
@@ -224,5 +223,4 @@ def test_every_shipped_experiment_passes_the_checks(make_cfg):
     for experiment in ("gps_qmcpf", "ism_pf_otb", "bis_pf", "fusion_pf"):
         runs, _, settings = prepare(make_cfg(experiment, *SMALL))
         assert runs and settings == ("loky", 2, None)
-    # the deprecated top-level backend= is still read
-    assert prepare(make_cfg("hspf_ungm", *SMALL, "backend=threading"))[2] == ("threading", 2, None)
+    assert prepare(make_cfg("hspf_ungm", *SMALL, "parallel.backend=threading"))[2] == ("threading", 2, None)

@@ -65,11 +65,7 @@ def check_overrides(argv: list[str]) -> None:
 
 
 def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
-    """``(backend, n_jobs, address)`` from ``parallel.*`` and ``n_jobs``, checked.
-
-    The top-level ``backend=`` of older commands is still read, as a deprecated
-    spelling of ``parallel.backend``.
-    """
+    """``(backend, n_jobs, address)`` from ``parallel.*`` and ``n_jobs``, checked."""
     parallel = cfg.get("parallel") or {}
     if not isinstance(parallel, (dict, DictConfig)):
         raise ConfigError(f"parallel must hold backend and address (parallel.backend=dask), got {parallel!r}")
@@ -77,13 +73,6 @@ def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
     if unknown:
         raise ConfigError(f"unknown key parallel.{unknown[0]}; parallel takes {', '.join(PARALLEL_KEYS)}")
     backend = parallel.get("backend") or "loky"
-    legacy = cfg.get("backend")
-    if legacy is not None:
-        if backend not in ("loky", legacy):
-            raise ConfigError(
-                f"backend={legacy} and parallel.backend={backend} disagree: set parallel.backend only"
-            )
-        backend = legacy
     n_jobs = cfg.get("n_jobs", 2)
     if isinstance(n_jobs, bool) or not isinstance(n_jobs, int) or n_jobs == 0:
         raise ConfigError(f"n_jobs must be a positive number of workers or -1 for all cores, got {n_jobs!r}")
