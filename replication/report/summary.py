@@ -114,7 +114,11 @@ def load_summaries(reports: Path) -> dict[str, dict]:
 def experiment_configs() -> dict[str, dict]:
     """Every experiment config as written (``conf/experiment/*.yaml``), by name.
 
-    Plain YAML (the configs use anchors, no interpolation): 20 times faster than OmegaConf here.
+    As written means without what a file inherits through Hydra's ``defaults:``,
+    on purpose: a derived experiment (an N sweep, an ablation, the OTB runs)
+    re-draws its parent's tables on other settings, and a published cell is
+    compared only with the experiment that declares its table.  Plain YAML
+    (the configs use anchors, no interpolation): 20 times faster than OmegaConf here.
     """
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
     return {name: yaml.load((CONF_DIR / "experiment" / f"{name}.yaml").read_text(), Loader=loader)
