@@ -90,6 +90,7 @@ class ColourHistogram:
             raise ValueError(f"at most 65535 bins in all, got {self.n_bins}")
         self.points, self.weights = sample_pattern(self.kernel, tuple(self.grid), self.samples, self.rng)
         self._u, self._v = (self.points[:, i].astype(np.float32) for i in (0, 1))
+        self._total_weight = float(self.weights.sum())  # of every sample of a box (fixed kernels)
         self._tiles: dict[int, np.ndarray] = {}
         u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
         self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
@@ -107,12 +108,13 @@ class ColourHistogram:
         With counts c_u and total T, rho = sum_u sqrt(c_u / T) sqrt(q_u) =
         (sqrt(c) . sqrt(q)) / sqrt(T): no normalised (N, B) array is formed, and
         the square root is taken in place over the tally, whose spare column
-        (points outside the image) meets a zero in sqrt(q).
+        (points outside the image) meets a zero in sqrt(q).  T is the kernel's
+        whole weight less that spare column.
         """
         root, rho, valid = np.append(np.sqrt(reference), 0.0), [], []
         for table, totals in self._tables(bin_image, boxes):
             inside = totals > 0
-            rho.append(np.sqrt(table, out=table) @ root / np.sqrt(np.where(inside, totals, 1.0)))
+            rho.append(cv2.sqrt(table, table) @ root / np.sqrt(np.where(inside, totals, 1.0)))  # cv2: twice numpy's speed
             valid.append(inside)
         return np.concatenate(rho), np.concatenate(valid)
 
@@ -133,7 +135,11 @@ class ColourHistogram:
         block = max(1, BLOCK_SAMPLES // len(self.weights))
         for i in range(0, len(boxes), block):
             bins, weights = self.gather(bin_image, boxes[i : i + block])
-            yield self.tally(bins, weights), np.where(bins != self.n_bins, weights, 0.0).sum(axis=1)
+            table = self.tally(bins, weights)
+            row = weights.sum(axis=1) if self.kernel == "diagonal" else self._total_weight
+            totals = row - table[:, -1]  # all the kernel's weight but the points outside the image
+            totals[totals <= 1e-9 * row] = 0.0  # nothing inside, up to rounding
+            yield table, totals
 
     def _tiled(self, n: int) -> np.ndarray:
         """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
