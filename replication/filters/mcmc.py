@@ -101,14 +101,16 @@ class MCMCPF(JointFilter):
         sources = rng.integers(len(carried[0]), size=total)
         proposals = np.empty((total, carried[0].shape[1]))
         log_like = np.empty(total)
-        for i, model in enumerate(state.models):  # every proposal and its likelihood, one pass per target
-            chosen = np.flatnonzero(targets == i)
-            proposals[chosen] = model.propagate(carried[i][sources[chosen]], state.t, rng)
-            log_like[chosen] = model.log_likelihood(proposals[chosen], z, state.t)
+        chosen = [np.flatnonzero(targets == i) for i in range(m)]
+        for i, model in enumerate(state.models):  # every proposal, one pass per target
+            proposals[chosen[i]] = model.propagate(carried[i][sources[chosen[i]]], state.t, rng)
         start = int(rng.integers(len(carried[0])))
         initial = np.stack([model.propagate(p[start : start + 1], state.t, rng)[0] for model, p in zip(state.models, carried)])
-        initial_like = np.array([model.log_likelihood(c[None], z, state.t)[0] for model, c in zip(state.models, initial)])
-        reachable = [np.vstack([proposals[targets == i], initial[i][None]]) for i in range(m)]
+        initial_like = np.empty(m)
+        for i, model in enumerate(state.models):  # the likelihoods of a target's proposals and start, one call
+            scored = model.log_likelihood(np.vstack([proposals[chosen[i]], initial[i]]), z, state.t)
+            log_like[chosen[i]], initial_like[i] = scored[:-1], scored[-1]
+        reachable = [np.vstack([proposals[chosen[i]], initial[i]]) for i in range(m)]
         adjacent = np.zeros((m, m), dtype=bool)
         for i, j in neighbours(reachable):
             adjacent[i, j] = adjacent[j, i] = True
