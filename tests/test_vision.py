@@ -74,6 +74,24 @@ def test_box_outside_the_image_has_an_empty_histogram_and_minus_infinity():
     assert log_like[0] == pytest.approx(-np.log(np.sqrt(2 * np.pi) * 0.1))  # rho = 1 at the reference box
 
 
+def test_histogram_memory_does_not_grow_with_the_number_of_distinct_batch_sizes():
+    """MCMC scores a different number of boxes each call: nothing may be kept per size (it once was: 450 MB)."""
+    import tracemalloc
+
+    histogram = ColourHistogram(grid=(10, 10))
+    likelihood = ColourLikelihood.from_frame(FRAME, np.array([40, 30, 10, 10]), histogram, sigma=0.1)
+    prepared = likelihood.prepare(FRAME)
+    boxes = np.tile([40.0, 30.0, 10.0, 10.0], (400, 1))
+    likelihood.log_likelihood(boxes, prepared)
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    for n in range(100, 400):
+        likelihood.log_likelihood(boxes[:n], prepared)
+    grown = tracemalloc.get_traced_memory()[0] - before
+    tracemalloc.stop()
+    assert grown < 100_000, grown  # 300 sizes x up to 400 boxes x 76 weights x 8 bytes = 36 MB if kept
+
+
 def test_sampled_histograms_use_the_stated_number_of_points():
     histogram = ColourHistogram(bins=(6, 6, 6), samples=100, rng=np.random.default_rng(1))
     assert len(histogram.points) <= 100 and len(histogram.points) > 50  # Epanechnikov drops the corners

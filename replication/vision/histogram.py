@@ -91,7 +91,7 @@ class ColourHistogram:
         self.points, self.weights = sample_pattern(self.kernel, tuple(self.grid), self.samples, self.rng)
         self._u, self._v = (self.points[:, i].astype(np.float32) for i in (0, 1))
         self._total_weight = float(self.weights.sum())  # of every sample of a box (fixed kernels)
-        self._tiles: dict[int, np.ndarray] = {}
+        self._tile = np.empty((0, len(self.weights)))  # the weights of the most boxes asked for at once
         u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
         self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
 
@@ -142,10 +142,11 @@ class ColourHistogram:
             yield table, totals
 
     def _tiled(self, n: int) -> np.ndarray:
-        """The kernel weights repeated for n boxes (cached: every frame asks for the same few n)."""
-        if n not in self._tiles:
-            self._tiles[n] = np.tile(self.weights, n)
-        return self._tiles[n]
+        """The kernel weights repeated for n boxes (n, K): the first rows of one array, grown to the
+        largest n asked for (at most a block), not one array per n (MCMC asks for a different n each call)."""
+        if len(self._tile) < n:
+            self._tile = np.tile(self.weights, (n, 1))
+        return self._tile[:n]
 
     def gather(self, bin_image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Bin index (n, K) of every sample point of ``boxes`` (n, >= 4: cx, cy, w, h), the spare bin B
@@ -162,7 +163,7 @@ class ColourHistogram:
             share = boxes[:, 2:3] ** 2 / (boxes[:, 2:3] ** 2 + boxes[:, 3:4] ** 2)
             weights = self._one_minus_v2 - share * self._u2_minus_v2
         else:
-            weights = self._tiled(n).reshape(n, -1)
+            weights = self._tiled(n)
         return gathered.astype(np.intp), weights
 
     def tally(self, bins: np.ndarray, weights: np.ndarray) -> np.ndarray:
