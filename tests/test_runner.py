@@ -215,6 +215,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
         sorted(grid.groupby("run_key")["rmse"].mean()))
     assert table.loc["T=10;N=500", "runs"] == 3  # PF does not depend on the grid: once, as a reference line
     assert (out / "experiment.methods.grid.n_points.png").stat().st_size > 10_000
+    assert 'href="sweeps/experiment.methods.grid.n_points.html"' in (out.parent / "index.html").read_text()
     bad = subprocess.run([sys.executable, "-m", "replication.report", "experiment=ungm_horizon", *settings,
                           f"store={tmp_path / 'experiments'}", "sweep=experiment.methods.grid.n_points=201", "metric=nope"],
                          cwd=PROJECT_ROOT, capture_output=True, text=True)

@@ -102,6 +102,7 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
                                + ([f"metric={metric}"] if metric else []))
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
                                       resolve(cfg.reports) / name / "sweeps", missing, command)
+            write_experiment_report(cfg, expand(cfg), Store(resolve(cfg.store), name))  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])
     for line in missing:

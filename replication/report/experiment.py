@@ -86,6 +86,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             if len(unmatched)
             else None,
             rules=RULES,
+            name=experiment["name"],
+            sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),
             command=f"python -m replication experiment={experiment['name']} scale={cfg.scale}",
             config=OmegaConf.to_yaml(cfg.experiment),
             versions=_versions(),
