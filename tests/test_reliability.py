@@ -16,7 +16,8 @@ import pytest
 from conftest import SMALL
 
 from replication.paths import PROJECT_ROOT
-from replication.runner.cli import check_overrides, prepare
+from replication.runner.cli import check_overrides
+from replication.runner.validate import prepare
 from replication.runner.config import ConfigError, expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.store import Store
