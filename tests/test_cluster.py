@@ -1,8 +1,13 @@
-"""Beyond one machine: the dask backend (a local distributed cluster standing in for a real one)
+"""Beyond one machine: the dask and ray backends (a local cluster standing in for a real one)
 and the threading backend store the same records as loky."""
 
 import logging
+import os
+import shutil
+import socket
+import subprocess
 import sys
+import time
 
 import pandas as pd
 import pytest
@@ -29,8 +34,6 @@ def cluster():
 
 
 def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, cluster):
-    import subprocess
-
     runs = expand(make_cfg("hspf_ungm", *TINY))
     loky = Store(tmp_path / "loky", "hspf_ungm")
     assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
@@ -56,11 +59,65 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, cluste
     pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
 
 
-@pytest.mark.parametrize("backend", ["threading", "dask"])
+@pytest.fixture(scope="module")
+def ray_head():
+    """A ray head node of 2 CPUs started as on a real cluster (``ray start --head``); its address.
+
+    Recent ray clusters authenticate with a token (``~/.ray/auth_token`` here): the command that
+    joins sets ``RAY_AUTH_MODE=token``, as a user's would.
+    """
+    pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
+    ray = shutil.which("ray", path=os.path.dirname(sys.executable))
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    env = {**os.environ, "RAY_AUTH_MODE": "token"}
+    head = subprocess.Popen(
+        [ray, "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
+         "--disable-usage-stats", "--block"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )
+    address = f"127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 120
+        while subprocess.run([ray, "status", f"--address={address}"], env=env, capture_output=True).returncode:
+            assert head.poll() is None and time.monotonic() < deadline, "the ray head node did not come up"
+            time.sleep(1)
+        yield address
+    finally:
+        head.terminate()  # --block: the head stops every process it started
+        head.wait(timeout=60)
+
+
+def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, ray_head):
+    """The command line pointed at the cluster, through ray's joblib backend (which returns whole
+    batches): the same records as loky, and the runs already stored are not sent again."""
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    loky = Store(tmp_path / "loky", "hspf_ungm")
+    assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
+    expected = deterministic_columns(loky.load(runs))
+
+    partial = Store(tmp_path / "cli", "hspf_ungm")
+    execute(runs[:2], partial, n_jobs=1, progress=False)
+    result = subprocess.run(
+        [
+            sys.executable, "-m", "replication", "experiment=hspf_ungm", *TINY,
+            "parallel.backend=ray", f"parallel.address={ray_head}",
+            f"store={tmp_path / 'cli'}", f"reports={tmp_path / 'reports'}", "progress=false",
+        ],
+        cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=180, env={**os.environ, "RAY_AUTH_MODE": "token"},
+    )
+    assert result.returncode == 0, result.stderr
+    assert f"{len(runs) - 2} runs computed, 2 already stored" in result.stdout
+    pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
+
+
+@pytest.mark.parametrize("backend", ["threading", "dask", "ray"])
 def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, backend):
-    """threading, and dask with no address (a local cluster of n_jobs workers), against loky."""
-    if backend == "dask":
-        pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    """threading, and dask and ray with no address (a local cluster of n_jobs workers), against loky."""
+    package = {"dask": "distributed", "ray": "ray"}.get(backend)
+    if package:
+        pytest.importorskip(package, reason=f"{package} is not installed (pip install -e '.[test]')")
     runs = expand(make_cfg("hspf_ungm", *TINY))
     frames = []
     for name in ("loky", backend):

@@ -4,7 +4,8 @@ Where the runs go is ``parallel.backend`` (see ``conf/config.yaml``): ``loky``
 worker processes on this machine (the default), ``threading``, or a cluster:
 ``dask`` (a ``distributed`` scheduler at ``parallel.address``, or a local
 cluster of ``n_jobs`` worker processes when no address is given) or ``ray``
-(``ray.init(address=parallel.address)``).  Wherever a run is computed, its
+(``ray.init(address=parallel.address)``; ray's joblib backend cannot stream
+results, so its records come back and are stored a batch at a time).  Wherever a run is computed, its
 record is a pure function of its identity and seed, so every backend stores
 the same numbers; only the records are sent back, and only this process
 writes the store.  Cluster workers need this package (and the same numpy,
@@ -22,7 +23,7 @@ from contextlib import contextmanager
 from typing import Iterator
 
 import numpy as np
-from joblib import Parallel, delayed, parallel_config
+from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
 import replication
@@ -34,6 +35,10 @@ from replication.tasks import TASKS
 TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps")  # machine-dependent: left out of determinism checks
 BACKENDS = ("loky", "threading", "dask", "ray")
 CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
+# ray's joblib backend returns whole lists only (no return_as="generator_unordered"): its records are
+# sent back, and stored, a batch of RUNS_PER_WORKER runs per worker at a time
+LIST_ONLY_BACKENDS = ("ray",)
+RUNS_PER_WORKER = 2
 
 
 class BackendError(RuntimeError):
@@ -94,9 +99,10 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
                 ray.init(address=address or None, log_to_driver=False)
             except (ConnectionError, RuntimeError, ValueError) as error:
                 where = f"ray at parallel.address={address}" if address else "ray on this machine"
-                raise BackendError(f"cannot start or reach {where}: {_one_line(error)}") from None
+                hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
+                raise BackendError(f"cannot start or reach {where}: {_one_line(error)}{hint}") from None
         try:
-            with parallel_config(backend="ray", n_jobs=n_jobs):
+            with parallel_config(backend="ray", n_jobs=-1 if address else n_jobs):
                 yield
         finally:
             if started:
@@ -136,6 +142,28 @@ def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
             cluster.close()
 
 
+def _records(pending: list[Run], streamed: bool) -> Iterator[dict]:
+    """Each run's record as it finishes, from the joblib backend in force.
+
+    Where the backend cannot stream, batches of a few runs per worker: an
+    interruption then loses at most one batch, and a batch waits for its
+    slowest run before the next starts.
+    """
+    if streamed:
+        results = Parallel(return_as="generator_unordered")(delayed(perform)(run) for run in pending)
+        try:
+            yield from results
+        finally:
+            with warnings.catch_warnings():  # joblib warns that the generator was left unfinished: we know
+                warnings.simplefilter("ignore")
+                results.close()  # if interrupted between two records: stop the workers now
+        return
+    batch = RUNS_PER_WORKER * effective_n_jobs(None)  # the n_jobs in force (a ray cluster: its CPUs)
+    with Parallel() as parallel:  # one pool for every batch
+        for start in range(0, len(pending), batch):
+            yield from parallel(delayed(perform)(run) for run in pending[start : start + batch])
+
+
 def _one_line(error: BaseException) -> str:
     return " ".join(str(error).split()) or error.__class__.__name__
 
@@ -172,13 +200,7 @@ def execute(
         mininterval=1.0,
     )
     with bar, parallel_backend(backend, n_jobs, address):
-        results = Parallel(return_as="generator_unordered")(delayed(perform)(run) for run in pending)
-        try:
-            for record in results:
-                store.write(by_id[record["run_id"]], record)
-                bar.update()
-        finally:
-            with warnings.catch_warnings():  # joblib warns that the generator was left unfinished: we know
-                warnings.simplefilter("ignore")
-                results.close()  # if interrupted between two records: stop the workers now
+        for record in _records(pending, streamed=backend not in LIST_ONLY_BACKENDS):
+            store.write(by_id[record["run_id"]], record)
+            bar.update()
     return len(pending)
