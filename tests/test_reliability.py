@@ -16,10 +16,12 @@ import pytest
 from conftest import SMALL
 
 from replication.paths import PROJECT_ROOT
+from joblib import Parallel, delayed
+
 from replication.runner.cli import check_overrides
-from replication.runner.validate import prepare
 from replication.runner.config import ConfigError, expand
-from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.execute import TIMING_COLUMNS, execute, parallel_backend
+from replication.runner.validate import prepare
 from replication.runner.store import Store
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
@@ -132,6 +134,14 @@ def test_sigint_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg,
     assert resumed.returncode == 0, resumed.stderr
     assert f"{len(runs) - after_sigkill} runs computed, {after_sigkill} already stored" in resumed.stdout
     pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
+
+
+def test_loky_workers_leave_ctrl_c_to_the_parent():
+    """A worker waiting for its next run must not turn the group's SIGINT into a traceback."""
+    with parallel_backend("loky", n_jobs=2):
+        handlers = Parallel()(delayed(signal.getsignal)(signal.SIGINT) for _ in range(4))
+    assert handlers == [signal.SIG_IGN] * 4
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the parent still gets Ctrl-C
 
 
 def test_two_processes_writing_one_store_leave_one_record_per_run(make_cfg, tmp_path):

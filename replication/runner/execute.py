@@ -16,10 +16,11 @@ same relative path.
 import importlib.util
 import logging
 import platform
+import signal
 import sys
 import time
 import warnings
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from typing import Iterator
 
 import numpy as np
@@ -107,9 +108,18 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
         finally:
             if started:
                 ray.shutdown()
+    elif backend == "loky":
+        with parallel_config(backend="loky", n_jobs=n_jobs, initializer=leave_interrupts_to_parent):
+            yield
     else:
         with parallel_config(backend=backend, n_jobs=n_jobs):
             yield
+
+
+def leave_interrupts_to_parent() -> None:
+    """A loky worker ignores SIGINT: a terminal's Ctrl-C reaches the whole process group, and a
+    worker caught waiting for its next run would print a traceback; the parent stops the workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 @contextmanager
@@ -152,7 +162,8 @@ def _records(pending: list[Run], streamed: bool) -> Iterator[dict]:
     if streamed:
         results = Parallel(return_as="generator_unordered")(delayed(perform)(run) for run in pending)
         try:
-            yield from results
+            for record in results:  # not "yield from": closing this generator must close results in here
+                yield record
         finally:
             with warnings.catch_warnings():  # joblib warns that the generator was left unfinished: we know
                 warnings.simplefilter("ignore")
@@ -199,8 +210,10 @@ def execute(
         disable=not progress,
         mininterval=1.0,
     )
-    with bar, parallel_backend(backend, n_jobs, address):
-        for record in _records(pending, streamed=backend not in LIST_ONLY_BACKENDS):
+    with bar, parallel_backend(backend, n_jobs, address), closing(
+        _records(pending, streamed=backend not in LIST_ONLY_BACKENDS)
+    ) as records:
+        for record in records:
             store.write(by_id[record["run_id"]], record)
             bar.update()
     return len(pending)
