@@ -136,11 +136,14 @@ def test_sigint_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg,
     pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
 
 
-def test_loky_workers_leave_ctrl_c_to_the_parent():
+@pytest.mark.parametrize("backend", ["loky", "dask"])
+def test_local_workers_leave_ctrl_c_to_the_parent(backend):
     """A worker waiting for its next run must not turn the group's SIGINT into a traceback."""
-    with parallel_backend("loky", n_jobs=2):
-        handlers = Parallel()(delayed(signal.getsignal)(signal.SIGINT) for _ in range(4))
-    assert handlers == [signal.SIG_IGN] * 4
+    if backend == "dask":
+        pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    with parallel_backend(backend, n_jobs=2):
+        ignored = Parallel()(delayed(lambda: signal.getsignal(signal.SIGINT) == signal.SIG_IGN)() for _ in range(4))
+    assert ignored == [True] * 4
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the parent still gets Ctrl-C
 
 

@@ -18,6 +18,7 @@ import logging
 import platform
 import signal
 import sys
+import threading
 import time
 import warnings
 from contextlib import closing, contextmanager
@@ -123,6 +124,20 @@ def leave_interrupts_to_parent() -> None:
 
 
 @contextmanager
+def _interrupts_ignored() -> Iterator[None]:
+    """SIGINT ignored while worker processes start, so that they keep ignoring it (an ignored
+    signal stays ignored across exec, and Python leaves it so); restored afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread may set handlers; it is the one a Ctrl-C reaches anyway
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextmanager
 def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
     from distributed import Client, LocalCluster
 
@@ -131,13 +146,14 @@ def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
         if address:
             client = Client(address)
         else:
-            cluster = LocalCluster(
-                n_workers=n_jobs if n_jobs > 0 else None,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=":0",
-                silence_logs=logging.ERROR,
-            )
+            with _interrupts_ignored():  # the workers inherit it: Ctrl-C is for this process alone
+                cluster = LocalCluster(
+                    n_workers=n_jobs if n_jobs > 0 else None,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=":0",
+                    silence_logs=logging.ERROR,
+                )
             client = Client(cluster)
     except (OSError, TimeoutError, ValueError) as error:
         if cluster is not None:
