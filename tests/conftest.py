@@ -31,7 +31,7 @@ def cli(tmp_path):
     """The command line as a user runs it, with its store and reports in a temporary folder."""
     import subprocess
 
-    def run(*args, timeout=300):
+    def run(*args, timeout=300, env=None):
         command = [
             sys.executable,
             "-m",
@@ -41,7 +41,7 @@ def cli(tmp_path):
             f"reports={tmp_path / 'reports'}",
             "progress=false",
         ]
-        return subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=timeout)
+        return subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=timeout, env=env)
 
     return run
 

@@ -12,9 +12,8 @@ import time
 import pandas as pd
 import pytest
 
-from replication.paths import PROJECT_ROOT
 from replication.runner.config import expand
-from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.execute import CLUSTER_PACKAGES, TIMING_COLUMNS, execute
 from replication.runner.store import Store
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
@@ -33,30 +32,36 @@ def cluster():
         yield local
 
 
-def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, cluster):
-    runs = expand(make_cfg("hspf_ungm", *TINY))
+def loky_records(runs: list, tmp_path) -> pd.DataFrame:
+    """The reference: the runs' records computed by the default local backend."""
     loky = Store(tmp_path / "loky", "hspf_ungm")
     assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
-    expected = deterministic_columns(loky.load(runs))
+    return deterministic_columns(loky.load(runs))
+
+
+def assert_command_line_resumes_on_cluster(cli, tmp_path, runs, expected, *cluster, timeout, env=None):
+    """The command line pointed at a cluster (``cluster``: its overrides) with two runs already
+    stored: those are not sent again, and the store ends with the reference records."""
+    partial = Store(tmp_path / "experiments", "hspf_ungm")  # the store ``cli`` writes to
+    execute(runs[:2], partial, n_jobs=1, progress=False)
+    result = cli("experiment=hspf_ungm", *TINY, *cluster, timeout=timeout, env=env)
+    assert result.returncode == 0, result.stderr
+    assert f"{len(runs) - 2} runs computed, 2 already stored" in result.stdout
+    pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
+
+
+def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, cluster):
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    expected = loky_records(runs, tmp_path)
 
     dask = Store(tmp_path / "dask", "hspf_ungm")
     assert execute(runs, dask, backend="dask", address=cluster.scheduler_address, progress=False) == len(runs)
     pd.testing.assert_frame_equal(deterministic_columns(dask.load(runs)), expected)
 
-    # the command line, pointed at the cluster; runs already there are not sent again
-    partial = Store(tmp_path / "cli", "hspf_ungm")
-    execute(runs[:2], partial, n_jobs=1, progress=False)
-    result = subprocess.run(
-        [
-            sys.executable, "-m", "replication", "experiment=hspf_ungm", *TINY,
-            "parallel.backend=dask", f"parallel.address={cluster.scheduler_address}",
-            f"store={tmp_path / 'cli'}", f"reports={tmp_path / 'reports'}", "progress=false",
-        ],
-        cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120,
+    assert_command_line_resumes_on_cluster(
+        cli, tmp_path, runs, expected,
+        "parallel.backend=dask", f"parallel.address={cluster.scheduler_address}", timeout=120,
     )
-    assert result.returncode == 0, result.stderr
-    assert f"{len(runs) - 2} runs computed, 2 already stored" in result.stdout
-    pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
 
 
 @pytest.fixture(scope="module")
@@ -89,33 +94,21 @@ def ray_head():
         head.wait(timeout=60)
 
 
-def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, tmp_path, ray_head):
+def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ray_head):
     """The command line pointed at the cluster, through ray's joblib backend (which returns whole
     batches): the same records as loky, and the runs already stored are not sent again."""
     runs = expand(make_cfg("hspf_ungm", *TINY))
-    loky = Store(tmp_path / "loky", "hspf_ungm")
-    assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
-    expected = deterministic_columns(loky.load(runs))
-
-    partial = Store(tmp_path / "cli", "hspf_ungm")
-    execute(runs[:2], partial, n_jobs=1, progress=False)
-    result = subprocess.run(
-        [
-            sys.executable, "-m", "replication", "experiment=hspf_ungm", *TINY,
-            "parallel.backend=ray", f"parallel.address={ray_head}",
-            f"store={tmp_path / 'cli'}", f"reports={tmp_path / 'reports'}", "progress=false",
-        ],
-        cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=180, env={**os.environ, "RAY_AUTH_MODE": "token"},
+    assert_command_line_resumes_on_cluster(
+        cli, tmp_path, runs, loky_records(runs, tmp_path),
+        "parallel.backend=ray", f"parallel.address={ray_head}",
+        timeout=180, env={**os.environ, "RAY_AUTH_MODE": "token"},
     )
-    assert result.returncode == 0, result.stderr
-    assert f"{len(runs) - 2} runs computed, 2 already stored" in result.stdout
-    pd.testing.assert_frame_equal(deterministic_columns(partial.load(runs)), expected)
 
 
 @pytest.mark.parametrize("backend", ["threading", "dask", "ray"])
 def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, backend):
     """threading, and dask and ray with no address (a local cluster of n_jobs workers), against loky."""
-    package = {"dask": "distributed", "ray": "ray"}.get(backend)
+    package = CLUSTER_PACKAGES.get(backend)
     if package:
         pytest.importorskip(package, reason=f"{package} is not installed (pip install -e '.[test]')")
     runs = expand(make_cfg("hspf_ungm", *TINY))
