@@ -106,11 +106,11 @@ class MCMCPF(JointFilter):
             proposals[chosen[i]] = model.propagate(carried[i][sources[chosen[i]]], state.t, rng)
         start = int(rng.integers(len(carried[0])))
         initial = np.stack([model.propagate(p[start : start + 1], state.t, rng)[0] for model, p in zip(state.models, carried)])
+        reachable = [np.vstack([proposals[chosen[i]], initial[i]]) for i in range(m)]
         initial_like = np.empty(m)
         for i, model in enumerate(state.models):  # the likelihoods of a target's proposals and start, one call
-            scored = model.log_likelihood(np.vstack([proposals[chosen[i]], initial[i]]), z, state.t)
+            scored = model.log_likelihood(reachable[i], z, state.t)
             log_like[chosen[i]], initial_like[i] = scored[:-1], scored[-1]
-        reachable = [np.vstack([proposals[chosen[i]], initial[i]]) for i in range(m)]
         adjacent = np.zeros((m, m), dtype=bool)
         for i, j in neighbours(reachable):
             adjacent[i, j] = adjacent[j, i] = True

@@ -71,9 +71,10 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
     name = key.rsplit(".", 1)[-1]
     out.mkdir(parents=True, exist_ok=True)
     stem = key.replace("/", "_")
-    tagged = records[~unaffected(records)]
+    same = unaffected(records)
+    tagged = records[~same]
     tagged = tagged.assign(condition=[f"{c};{name}={v}".lstrip(";") for c, v in zip(tagged["condition"], tagged["swept"])])
-    tagged = pd.concat([tagged, records[unaffected(records) & (records["swept"] == records["swept"].iloc[0])]])
+    tagged = pd.concat([tagged, records[same & (records["swept"] == records["swept"].iloc[0])]])
     table = summarise(tagged, metric)
     table.to_csv(out / f"{stem}.csv", index=False)
     sections = []
