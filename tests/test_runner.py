@@ -2,6 +2,8 @@
 
 import json
 import os
+import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -15,6 +17,7 @@ from conftest import SMALL
 from replication.paths import PROJECT_ROOT
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.provenance import code_digest
 from replication.runner.seeding import seed_sequence
 from replication.runner.store import Store
 
@@ -112,6 +115,35 @@ def test_changed_config_lands_in_new_files(make_cfg, tmp_path):
     store = Store(tmp_path / "store", "hspf_ungm")
     execute(base, store, n_jobs=1, progress=False)
     assert store.load(changed).empty
+
+
+def test_changed_code_lands_in_new_runs(tmp_path):
+    """A copy of the project whose bootstrap filter differs by one comment recomputes every run; a change
+    to the report layer (which only reads records) reuses them.  Run through the CLI, as a user would."""
+    copy = tmp_path / "project"
+    shutil.copytree(PROJECT_ROOT, copy, ignore=shutil.ignore_patterns(".venv", ".git", "experiments", "reports",
+                                                                      "__pycache__", "*.egg-info"))
+    env = {**os.environ, "PYTHONPATH": str(copy)}
+    command = [sys.executable, "-m", "replication", "experiment=hspf_ungm", "scale=quick",
+               "experiment.runs.quick=2", "progress=false", "n_jobs=1"]
+
+    def computed() -> int:
+        done = subprocess.run(command, cwd=copy, env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        return int(re.search(r"(\d+) runs computed", done.stdout)[1])
+
+    first = computed()
+    assert first > 0 and computed() == 0
+    with open(copy / "replication" / "report" / "render.py", "a") as report:
+        report.write("# a report change\n")
+    assert computed() == 0
+    with open(copy / "replication" / "filters" / "bootstrap.py", "a") as code:
+        code.write("# a filter change\n")
+    assert computed() == first
+    record = json.loads(next((copy / "experiments" / "hspf_ungm" / "runs").glob("*.json")).read_text())
+    assert record["code_digest"] == code_digest(copy / "replication") != code_digest()
+    assert {"git_commit", "git_dirty", "numpy_version", "scipy_version", "opencv_version", "numba_version",
+            "machine", "computed_at"} <= set(record)
 
 
 def test_store_write_is_atomic(tmp_path, make_cfg):

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-import replication
 from replication.filters import FILTERS
+from replication.runner.provenance import code_digest
 from replication.runner.seeding import seed_sequence
 
 SCALES = ("paper", "quick")
@@ -90,10 +90,10 @@ def _sweeps(params: dict[str, Any], on_model: bool, where: str) -> list[tuple[bo
 
 
 def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
-    """Hash of everything that can change a run's numbers (not its repetition)."""
+    """Hash of everything that can change a run's numbers (not its repetition): the config and the code."""
     numeric = {k: v for k, v in method.items() if k != "label"}
     blob = json.dumps(
-        {"task": task, "model": model, "method": numeric, "seed": base_seed, "version": replication.__version__},
+        {"task": task, "model": model, "method": numeric, "seed": base_seed, "code": code_digest()},
         sort_keys=True,
     )
     return hashlib.sha256(blob.encode()).hexdigest()[:10]

@@ -15,7 +15,6 @@ same relative path.
 
 import importlib.util
 import logging
-import platform
 import signal
 import sys
 import threading
@@ -24,17 +23,18 @@ import warnings
 from contextlib import closing, contextmanager
 from typing import Iterator
 
-import numpy as np
 from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
 import replication
 from replication.runner.config import Run
 from replication.runner.memory import retain_freed_memory
+from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
 from replication.tasks import TASKS
 
-TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps")  # machine-dependent: left out of determinism checks
+# machine- and moment-dependent: left out of determinism checks
+TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps", "computed_at")
 BACKENDS = ("loky", "threading", "dask", "ray")
 CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
 # ray's joblib backend returns whole lists only (no return_as="generator_unordered"): its records are
@@ -58,8 +58,7 @@ def perform(run: Run) -> dict:
         "wall_s": time.perf_counter() - started,
         "base_seed": run.base_seed,
         "replication_version": replication.__version__,
-        "numpy_version": np.__version__,
-        "python_version": platform.python_version(),
+        **provenance(),
     }
 
 

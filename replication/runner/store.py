@@ -2,7 +2,8 @@
 
 Layout: ``<root>/<experiment>/runs/<method>__<condition>__<key>__r<rep>.json``.
 The key hashes everything that can change a run's numbers (task, model and
-method parameters, base seed, package version), so a changed config lands in
+method parameters, base seed, and the digest of the code that computes runs,
+:func:`replication.runner.provenance.code_digest`), so a changed config lands in
 new files and is never mixed with old runs, while adding repetitions, methods
 or sweep values reuses every run already stored.
 
@@ -30,8 +31,8 @@ final name (``os.replace``, atomic on local POSIX file systems and on NFS).  So
   of its identity and seed both records agree in every column except the
   wall-clock timings (``execute.TIMING_COLUMNS``) -- the last writer's
   timings are kept.  (That holds for machines with the same numpy, scipy
-  and Python: the key covers this package's version only, and the records
-  carry ``numpy_version`` and ``python_version`` to show where they came from.)
+  and Python: the key covers this package's code only, and the records
+  carry the library versions, machine and git commit to show where they came from.)
 * work can be duplicated, not results: nothing locks a run while it is
   computed, so two machines started on the same experiment at once may both
   compute some runs.  Split the work (different experiments, methods or
