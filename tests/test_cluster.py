@@ -3,6 +3,7 @@ and the threading backend store the same records as loky."""
 
 import logging
 import os
+import secrets
 import shutil
 import socket
 import subprocess
@@ -65,27 +66,33 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, c
 
 
 @pytest.fixture(scope="module")
-def ray_head():
-    """A ray head node of 2 CPUs started as on a real cluster (``ray start --head``); its address.
+def ray_env():
+    """The environment of every process that starts or joins the test's ray head node: token
+    authentication (recent ray's default; ``RAY_AUTH_MODE=token``, as a user's command sets it)
+    under a token of the test's own. Ray reads ``RAY_AUTH_TOKEN`` before any token file
+    (``RAY_AUTH_TOKEN_PATH``, then ``~/.ray/auth_token``), so the test neither needs a token in the
+    home directory (a machine that never ran ray has none) nor writes one there."""
+    return {**os.environ, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(32)}
 
-    Recent ray clusters authenticate with a token (``~/.ray/auth_token`` here): the command that
-    joins sets ``RAY_AUTH_MODE=token``, as a user's would.
-    """
+
+@pytest.fixture(scope="module")
+def ray_head(ray_env):
+    """A ray head node of 2 CPUs started as on a real cluster (``ray start --head``); its address.
+    It and the command that joins it authenticate with the token in ``ray_env``."""
     pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
     ray = shutil.which("ray", path=os.path.dirname(sys.executable))
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    env = {**os.environ, "RAY_AUTH_MODE": "token"}
     head = subprocess.Popen(
         [ray, "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
          "--disable-usage-stats", "--block"],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        env=ray_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )
     address = f"127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + 120
-        while subprocess.run([ray, "status", f"--address={address}"], env=env, capture_output=True).returncode:
+        while subprocess.run([ray, "status", f"--address={address}"], env=ray_env, capture_output=True).returncode:
             assert head.poll() is None and time.monotonic() < deadline, "the ray head node did not come up"
             time.sleep(1)
         yield address
@@ -94,23 +101,37 @@ def ray_head():
         head.wait(timeout=60)
 
 
-def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ray_head):
+def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ray_env, ray_head):
     """The command line pointed at the cluster, through ray's joblib backend (which returns whole
     batches): the same records as loky, and the runs already stored are not sent again."""
     runs = expand(make_cfg("hspf_ungm", *TINY))
     assert_command_line_resumes_on_cluster(
         cli, tmp_path, runs, loky_records(runs, tmp_path),
         "parallel.backend=ray", f"parallel.address={ray_head}",
-        timeout=180, env={**os.environ, "RAY_AUTH_MODE": "token"},
+        timeout=180, env=ray_env,
     )
 
 
 @pytest.mark.parametrize("backend", ["threading", "dask", "ray"])
-def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, backend):
-    """threading, and dask and ray with no address (a local cluster of n_jobs workers), against loky."""
+def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, monkeypatch, backend):
+    """threading, and dask and ray with no address (a local cluster of n_jobs workers), against loky.
+
+    ray: ``RAY_ADDRESS=local`` makes ``ray.init()`` start that local cluster rather than join one
+    already running on this machine (the ``ray_head`` node, when this module runs whole: it did so,
+    unseen, while both shared the token in ``~/.ray/auth_token``), and the cluster gets the test's
+    own token, which ``ray.init()`` would otherwise write into ``~/.ray/auth_token``. Token mode is
+    left for ``ray.init()`` to turn on, as for any new local cluster: it sets ``RAY_AUTH_MODE`` in
+    this process and reloads its configuration (set here, after ``import ray``, it would go unseen
+    by this process but not by the cluster's, and the two would not agree); that is undone after."""
     package = CLUSTER_PACKAGES.get(backend)
     if package:
         pytest.importorskip(package, reason=f"{package} is not installed (pip install -e '.[test]')")
+    if backend == "ray":
+        monkeypatch.setenv("RAY_ADDRESS", "local")
+        monkeypatch.setenv("RAY_AUTH_TOKEN", secrets.token_hex(32))
+        if "RAY_AUTH_MODE" not in os.environ:
+            monkeypatch.setenv("RAY_AUTH_MODE", "")  # recorded as unset, so removed again at teardown
+            monkeypatch.delenv("RAY_AUTH_MODE")
     runs = expand(make_cfg("hspf_ungm", *TINY))
     frames = []
     for name in ("loky", backend):
