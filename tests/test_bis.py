@@ -202,7 +202,7 @@ def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     from conftest import SMALL
 
     from replication.report.published import load_published
-    from replication.report.tables import build_rating_table
+    from replication.report.tables import Rating
     from replication.runner.config import expand
     from replication.runner.execute import execute
     from replication.runner.store import Store
@@ -219,6 +219,6 @@ def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     experiment = OmegaConf.to_container(cfg.experiment, resolve=True)
     with pytest.warns(UserWarning, match="published values not found"):  # a missing file is not fatal
         published = load_published(str(tmp_path / "absent.csv"))
-    spec = {"paper_table": "3", "metric": "failed", "paper_metric": "stability"}
-    table, _ = build_rating_table(records, spec, experiment, published)
-    assert set(table["ours"]) <= {"good", "medium", "poor"} and len(table) == 2
+    spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability"}
+    table = Rating(spec, experiment, published).build(records).frame
+    assert set(table["rating"]) <= {"good", "medium", "poor"} and len(table) == 2

@@ -4,10 +4,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.report.aggregate import comparison_interval, mean_interval, summarise
+from scipy import stats
+
+from replication.report.aggregate import summarise
 from replication.report.published import load_published
-from replication.report.tables import build_table, format_table
-from replication.report.verdict import verdict
+from replication.report.quantities import quantity
+from replication.report.statistics import (
+    RESAMPLES, SEED, Estimate, bootstrap_mean, estimate, median, paired_difference, proportion, rate_test,
+)
+from replication.report.tables import Comparison, stability_bands
+from replication.report.verdict import Outcome, Verdict, judge_band, judge_value
 
 EXPERIMENT = {
     "paper": "gps_qmcpf",
@@ -15,42 +21,94 @@ EXPERIMENT = {
 }
 
 
-def test_mean_interval_hand_computed():
-    # mean 2, sd 1, n = 3: t_{0.975, 2} = 4.302653; half-width = 4.302653 / sqrt(3)
-    mean, low, high = mean_interval([1.0, 2.0, 3.0])
-    assert mean == 2.0
-    assert high - mean == pytest.approx(4.302653 / np.sqrt(3), rel=1e-6)
-    assert mean - low == pytest.approx(high - mean)
-    assert np.isnan(mean_interval([5.0])[1])
-    assert np.isnan(mean_interval([])[0])
+def test_wilson_interval_hand_case_and_scipy():
+    # 3 of 10: Wilson's score interval, p +- z sqrt(p(1-p)/n + z^2/4n^2) / (1 + z^2/n) around the shrunk centre
+    z = stats.norm.ppf(0.975)
+    centre = (0.3 + z**2 / 20) / (1 + z**2 / 10)
+    half = z * np.sqrt(0.3 * 0.7 / 10 + z**2 / 400) / (1 + z**2 / 10)
+    found = proportion(3, 10)
+    assert found.value == 0.3 and found.method == "Wilson"
+    assert (found.low, found.high) == pytest.approx((centre - half, centre + half), rel=1e-9)
+    scipy_ci = stats.binomtest(3, 10).proportion_ci(method="wilson")
+    assert (found.low, found.high) == pytest.approx((scipy_ci.low, scipy_ci.high), rel=1e-12)
+    none = proportion(0, 10)  # 0 of 10: not the zero-width [0, 0] of a t-interval
+    assert none.low == 0.0 and none.high == pytest.approx(0.2775, abs=1e-4)
+    assert proportion(10, 10).high == 1.0 and proportion(10, 10).low < 1.0
 
 
-def test_comparison_interval_widens_for_the_papers_own_noise():
-    # sd 2, 25 runs of ours, 100 of theirs: half-width t_{0.975,24} * 2 * sqrt(1/25 + 1/100)
-    low, high = comparison_interval(10.0, 2.0, 25, 100)
-    assert high - 10.0 == pytest.approx(2.063899 * 2.0 * np.sqrt(0.05), rel=1e-5)
-    assert 10.0 - low == pytest.approx(high - 10.0)
-    own = comparison_interval(10.0, 2.0, 25, None)
-    assert own[1] - 10.0 == pytest.approx(2.063899 * 2.0 / 5.0, rel=1e-5)  # our own 95% interval
-    assert np.isnan(comparison_interval(1.0, np.nan, 1, 100)[0])
+def test_bootstrap_mean_is_scipys_bca_and_stays_in_range():
+    values = np.array([0.0, 0.0, 0.0, 0.1, 0.9, 1.0, 1.0, 1.0, 1.0, 1.0])
+    found = bootstrap_mean(values, 0.0, 1.0)
+    reference = stats.bootstrap((values,), np.mean, method="BCa", n_resamples=RESAMPLES,
+                                random_state=np.random.default_rng(SEED)).confidence_interval
+    assert found.value == pytest.approx(0.6)
+    assert (found.low, found.high) == pytest.approx((reference.low, reference.high))
+    near_top = bootstrap_mean(np.r_[np.ones(19), 0.2], 0.0, 1.0)  # a share near its bound
+    assert 0.0 <= near_top.low <= near_top.value <= near_top.high <= 1.0
+    assert bootstrap_mean([2.0, 2.0, 2.0]).low == 2.0  # nothing to resample
+    assert np.isnan(bootstrap_mean([5.0]).low) and np.isnan(bootstrap_mean([]).value)
 
 
-def test_interval_covers_the_true_mean_about_95_percent_of_the_time():
+def test_bootstrap_interval_covers_the_true_mean_about_95_percent_of_the_time():
     rng = np.random.default_rng(0)
-    covered = 0
-    for _ in range(2000):
-        _, low, high = mean_interval(rng.exponential(1.0, size=30))
-        covered += low <= 1.0 <= high
-    assert 0.91 < covered / 2000 < 0.97  # skewed data: t-intervals undercover a little
+    covered = sum(bootstrap_mean(rng.exponential(1.0, size=30)).contains(1.0) for _ in range(300))
+    assert 0.88 < covered / 300 < 0.99
 
 
-def test_verdict_rules():
-    assert verdict(np.nan, 1.0, 0.9, 1.1, "rmse") == "reference"
-    assert verdict(1.05, 1.0, 0.9, 1.1, "rmse") == "agrees"
-    assert verdict(2.0, 1.0, 0.9, 1.1, "rmse") == "differs (-50%)"
-    assert verdict(0.5, 1.0, 0.9, 1.1, "rmse") == "differs (+100%)"
-    assert verdict(1.6, 4.5, 4.0, 5.0, "rmse", floor_low=4.1) == "below the Bayes floor (4.1)"
-    assert verdict(10.0, 0.5, 0.4, 0.6, "time").startswith("machine-dependent (ours/theirs = 0.05")
+def test_median_interval_uses_binomial_order_statistics():
+    values = np.arange(1.0, 11.0)  # n = 10: ranks 2 and 9 (P(2 <= B <= 8) >= 0.95 for B ~ Bin(10, 1/2))
+    found = median(values[::-1])
+    assert found.value == 5.5 and (found.low, found.high) == (2.0, 9.0)
+    assert np.isnan(median([1.0, 2.0, 3.0]).low)  # too few runs for a 95% order-statistic interval
+
+
+def test_estimate_fits_its_quantity():
+    assert estimate(np.array([0.0, 1.0, 1.0, 0.0, 1.0]), quantity("failed")).method == "Wilson"
+    percent = estimate(np.array([0, 100, 100, 0, 100.0]), quantity("tracked_to_end[cle<=20]").scaled(100))
+    assert percent.value == 60.0 and percent.high <= 100.0 and percent.low >= 0.0
+    assert estimate(np.array([1.0, 2.0, 3.0]), quantity("rmse")).method == "BCa bootstrap"
+    assert quantity("correct_frames[iou>=0.5]").high == 1.0 and quantity("mota").high == 1.0
+    assert quantity("ms_per_frame").machine_dependent
+
+
+def test_paired_difference_is_the_bootstrap_of_per_run_differences():
+    ours, theirs = np.array([1.0, 2.0, 3.0, 4.0, 5.5]), np.array([1.5, 2.4, 3.1, 4.6, 5.7])
+    found = paired_difference(ours, theirs)
+    assert found.value == pytest.approx(np.mean(ours - theirs))
+    assert (found.low, found.high) == pytest.approx(
+        (bootstrap_mean(ours - theirs).low, bootstrap_mean(ours - theirs).high))
+
+
+def test_fisher_exact_rate_test_matches_scipy():
+    # ours 3 of 20 against the paper's 39.3 % of 100 runs (39 of 100)
+    assert rate_test(3, 20, 0.393, 100) == pytest.approx(stats.fisher_exact([[3, 17], [39, 61]]).pvalue)
+
+
+def test_cell_verdicts():
+    rmse = quantity("rmse")
+    ours = Estimate(1.0, 0.9, 1.1, 20, "BCa bootstrap")
+    assert judge_value(np.nan, ours, rmse) is None  # a row of ours with no published number
+    assert judge_value(1.05, ours, rmse) == Verdict(Outcome.REPRODUCED)
+    assert judge_value(2.0, ours, rmse) == Verdict(Outcome.NOT_REPRODUCED, "-50%")
+    assert judge_value(1.13, ours, rmse).outcome is Outcome.NOT_REPRODUCED
+    assert judge_value(1.13, ours, rmse, paper_runs=20).outcome is Outcome.REPRODUCED  # widened by sqrt(2)
+    assert judge_value(0.5, ours, rmse, floor_low=0.8) == Verdict(Outcome.NOT_REPRODUCED, "below the Bayes floor 0.8")
+    assert judge_value(10.0, Estimate(0.5, 0.4, 0.6, 20, ""), quantity("ms_per_frame")).outcome \
+        is Outcome.NOT_TESTABLE
+    assert judge_value(1.05, Estimate(1.0, 0.9, 1.1, 4, ""), rmse) == Verdict(Outcome.NOT_TESTABLE, "too few runs (4)")
+    percent = quantity("tracked_to_end[cle<=20]").scaled(100)
+    assert judge_value(39.3, Estimate(15.0, 5.0, 36.0, 20, "Wilson"), percent, paper_runs=100).why.startswith(
+        "Fisher's exact test p = ")
+    assert str(Verdict(Outcome.NOT_REPRODUCED, "-50%")) == "not reproduced (-50%)"
+    assert Verdict.from_dict(Verdict(Outcome.INCONCLUSIVE, "x").as_dict()) == Verdict(Outcome.INCONCLUSIVE, "x")
+
+
+def test_band_verdicts_for_ratings():
+    bands = stability_bands()
+    assert judge_band("good", proportion(0, 10), bands).outcome is Outcome.INCONCLUSIVE  # [0, 0.28]: good or medium
+    assert judge_band("good", proportion(0, 40), bands).outcome is Outcome.REPRODUCED  # [0, 0.088]
+    assert judge_band("good", proportion(8, 10), bands) == Verdict(Outcome.NOT_REPRODUCED, "ours: poor")
+    assert judge_band("poor", proportion(3, 4), bands).outcome is Outcome.NOT_TESTABLE  # 4 runs
 
 
 def test_summarise_groups_by_method_and_condition():
@@ -96,26 +154,28 @@ def records():
 
 def test_table_joins_paper_values_and_judges_against_the_floor(published):
     spec = {"name": "t", "title": "t", "paper_table": "1", "metric": "rmse"}
-    table, matched = build_table(records(), spec, EXPERIMENT, published)
-    rows = table.set_index("condition")
-    assert rows.loc["N=10", "paper"] == 1.5 and rows.loc["N=10", "verdict"] == "agrees"
-    assert rows.loc["N=20", "verdict"].startswith("below the Bayes floor")
-    assert rows.loc["-", "verdict"] == "reference"
+    table = Comparison(spec, EXPERIMENT, published).build(records())
+    rows = table.frame.set_index("condition")
+    assert rows.loc["N=10", "paper"] == 1.5 and rows.loc["N=10", "verdict"].outcome is Outcome.REPRODUCED
+    assert rows.loc["N=20", "verdict"].why.startswith("below the Bayes floor")
+    assert rows.loc["-", "verdict"] is None  # the floor: a row of ours with no published counterpart
     # the paired excess over the floor is exact here: each run is floor + a constant
-    assert rows.loc["N=10", "excess_over_floor"] == pytest.approx(0.5)
-    assert rows.loc["N=10", "excess_ci_high"] - rows.loc["N=10", "excess_ci_low"] == pytest.approx(0.0, abs=1e-12)
-    assert len(matched) == 2  # the QPF cell stays unmatched
-    text = format_table(table)
-    assert "paper" in text.columns and "excess over the floor (paired, 95% CI)" in text.columns
+    assert rows.loc["N=10", "excess over the floor (paired, 95% CI)"] == "0.5 [0.5, 0.5]"
+    assert {e["published_index"] for e in table.cells} == {0, 1}  # the QPF cell stays unmatched
+    shown = table.shown()
+    assert {"ours (95% CI)", "paper", "verdict"} <= set(shown.columns) and "estimate" not in shown
+    written = table.written()
+    assert set(written["outcome"]) == {"reproduced", "not reproduced", ""}
+    assert (table.read(written).shown() == shown).all().all()  # the PDF draws the CSV as the page shows it
 
 
 def test_unstated_paper_condition_is_mapped(published):
     frame = records().assign(mean_ess=lambda f: np.where(f["condition"] == "N=10", 7.0, np.nan))
     frame.loc[frame["condition"] == "N=10", "mean_ess"] += np.linspace(-0.5, 0.5, 10)
     spec = {"name": "e", "title": "e", "paper_table": "2", "metric": "mean_ess", "paper_condition": "N=10"}
-    table, matched = build_table(frame, spec, EXPERIMENT, published)
+    table = Comparison(spec, EXPERIMENT, published).build(frame).frame
     assert list(table["condition"]) == ["N=10"]  # rows with no finite value are dropped
-    assert table["paper"].iloc[0] == 7.0 and table["verdict"].iloc[0] == "agrees"
+    assert table["paper"].iloc[0] == 7.0 and table["verdict"].iloc[0].outcome is Outcome.REPRODUCED
 
 
 def test_published_values_file_has_every_ungm_cell_we_report():

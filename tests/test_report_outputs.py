@@ -15,9 +15,10 @@ from hydra import compose, initialize_config_dir
 from replication.paths import CONF_DIR, resolve
 from replication.report.index import write_index
 from replication.report.published import load_published
+from replication.report.quantities import quantity
 from replication.report.render import ENVIRONMENT, browser, open_in_browser
-from replication.report.summary import KEYS, experiment_configs, matched_cells, summary_table
-from replication.report.tables import build_improvement_table, build_rating_table, build_table
+from replication.report.summary import experiment_configs, summary_table
+from replication.report.tables import KEYS, TableKind
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 CSV = (
@@ -46,6 +47,9 @@ CONFIGS = {
 }
 
 
+REPRODUCED = {"outcome": "reproduced", "why": ""}
+
+
 def _cell(published, index, **ours) -> dict:
     return {"published_index": index, **{k: published.at[index, k] for k in KEYS}, "our_condition": "",
             "runs": 20, "ci_low": None, "ci_high": None, **ours}
@@ -61,20 +65,23 @@ def published(tmp_path):
 def test_summary_has_one_row_per_published_cell_with_ours_or_a_reason(published):
     summaries = {
         "qmc_ungm": {"scale": "paper", "n_records": 40, "cells": [
-            _cell(published, 0, table_name="t1", ours=4.0, ci_low=3.5, ci_high=4.5, verdict="agrees"),
-            _cell(published, 0, table_name="t1_other", ours=5.0, verdict="differs (+19%)"),
+            _cell(published, 0, table_name="t1", ours=4.0, ci_low=3.5, ci_high=4.5, verdict=REPRODUCED),
+            _cell(published, 0, table_name="t1_other", ours=5.0,
+                  verdict={"outcome": "not reproduced", "why": "+19%"}),
         ]},
         "trk": {"scale": "quick", "n_records": 6, "cells": [
             _cell(published, 4, table_name="time", our_condition="scene=office", ours=1.5,
-                  verdict="machine-dependent (ours/theirs = 0.33)"),
+                  verdict={"outcome": "not testable", "why": "machine-dependent; ours/theirs = 0.33"}),
         ]},
     }
     table = summary_table(published, summaries, CONFIGS)
     assert len(table) == len(published)
     assert list(table["method"]) == list(published["method"])  # the csv's order
     first = table.iloc[0]
-    assert first["ours"] == "4 [3.5, 4.5]" and first["verdict"] == "agrees" and first["reason"] == ""
+    assert first["ours"] == "4 [3.5, 4.5]" and first["verdict"] == "reproduced" and first["reason"] == ""
+    assert first["outcome"] == "reproduced"
     assert first["link"] == "qmc_ungm/index.html#t1" and "t1_other" in first["also"]
+    assert "not reproduced (+19%)" in first["also"]
     assert table.iloc[4]["our_condition"] == "scene=office" and table.iloc[4]["paper_value"] == "4.5 ms"
     reasons = list(table["reason"])
     assert reasons[1].startswith("method not reproduced: QPF")
@@ -93,14 +100,14 @@ def test_index_shows_the_summary_from_the_experiments_summary_json(tmp_path, pub
     (reports / "gps_qmcpf").mkdir(parents=True)
     (reports / "gps_qmcpf" / "summary.json").write_text(json.dumps({
         "name": "gps_qmcpf", "title": "QMC filters", "paper": "qmc", "scale": "quick", "n_records": 4,
-        "n_runs": 4, "verdicts": {"agrees": 1},
+        "n_runs": 4, "verdicts": {"reproduced": 1},
         "cells": [_cell(published, 0, table_name="table1_rmse", ours=4.0, ci_low=3.5, ci_high=4.5,
-                        verdict="agrees")],
+                        verdict=REPRODUCED)],
     }))
     page = write_index(reports, tmp_path / "published.csv")
     html = page.read_text()
     body = html.split('<table id="cells"', 1)[1].split("</table>", 1)[0]
-    assert body.count("<tr>") == 1 + len(published)  # header + one row per cell
+    assert body.count("<tr") == 1 + len(published)  # header + one row per cell
     assert 'href="gps_qmcpf/index.html#table1_rmse"' in body and "4 [3.5, 4.5]" in body
     assert "no value in the paper: failed (reported as error)" in body
     assert len(pd.read_csv(reports / "summary.csv", keep_default_na=False)) == len(published)
@@ -110,7 +117,7 @@ def _fabricated_records(runs, metrics, rng) -> pd.DataFrame:
     frame = pd.DataFrame([r.identity() for r in runs])
     for metric in metrics:
         n = len(frame)
-        frame[metric] = rng.integers(0, 2, n) if metric == "failed" else rng.uniform(1, 10, n)
+        frame[metric] = rng.integers(0, 2, n) if quantity(metric).proportion else rng.uniform(0, 1, n)
     return frame
 
 
@@ -133,13 +140,13 @@ def test_matched_cells_name_every_published_cell_a_table_matched(name):
              if "paper_table" in s and "metrics" not in s and s.get("kind") != "modes"]
     records = _fabricated_records(runs, {s["metric"] for s in specs}, np.random.default_rng(0))
     published = load_published(str(PUBLISHED))
-    build = {"rating": build_rating_table, "improvement": build_improvement_table}
     compared = 0
     for spec in specs:
-        table, hits = build.get(spec.get("kind"), build_table)(records, spec, experiment, published)
-        entries = matched_cells(table, hits, published, spec, experiment)
-        assert {e["published_index"] for e in entries} == set(hits), spec["name"]
-        assert all(e["verdict"] != "matched" and e["our_method"] in set(table["method"]) for e in entries)
+        table = TableKind.of(spec, experiment, published).build(records)
+        entries = table.cells
+        assert all(e["our_method"] in set(table.frame["method"]) for e in entries), spec["name"]
+        pairs = {(e["published_index"], e["our_method"], e["our_condition"]) for e in entries}
+        assert len(pairs) == len(entries)  # one entry per cell and row of ours (two stand-ins: two entries)
         for e in entries:
             assert tuple(e[k] for k in KEYS) == tuple(published.loc[e["published_index"], KEYS])
         json.dumps(entries, allow_nan=False)  # plain JSON: no NaN, no numpy types
@@ -230,6 +237,43 @@ def test_summary_in_the_index_covers_every_published_cell(reports):
         assert rmse["reason"].str.startswith("see gps_qmcpf's page").all()
     html = (reports / "index.html").read_text()
     assert 'href="replication.pdf"' in html and 'id="cells"' in html
+    assert html.index('id="scorecard"') < html.index('id="cells"')  # the claims come first
+    assert 'id="scale-banner"' in html and "make replicate SCALE=paper" in html  # quick scale, said up front
+    assert 'id="scale-banner"' in (reports / "gps_qmcpf" / "index.html").read_text()
+
+
+def test_claims_csv_has_one_row_per_claim_with_a_verdict_and_its_interval(reports):
+    from replication.report.claims import load_papers
+
+    claims = pd.read_csv(reports / "claims.csv", keep_default_na=False)
+    expected = [c.id for p in load_papers() for c in p.claims]
+    assert list(claims["claim_id"]) == expected
+    assert set(claims["verdict"]) <= {"reproduced", "not reproduced", "inconclusive", "not testable"}
+    assert claims["cells"].astype(int).sum() == len(load_published(str(PUBLISHED)))
+    rmse = claims.set_index("claim_id").loc["gps_qmcpf.rmse"]
+    assert rmse["verdict"] == "not testable" and rmse["reason"] == "too few runs (2)"  # 2 runs: no verdict
+    judged = claims[claims["ci_low"] != ""]
+    assert (judged["ci_low"].astype(float) <= judged["number"].astype(float)).all()
+    assert (judged["number"].astype(float) <= judged["ci_high"].astype(float)).all()
+    uniform = claims.set_index("claim_id").loc["gps_qmcpf.uniform"]  # no runs needed: deterministic point sets
+    assert uniform["verdict"] == "not reproduced" and uniform["robustness"].startswith("hinges on the reading")
+
+
+def test_no_interval_in_the_reports_leaves_its_metrics_range(reports):
+    from replication.report.quantities import quantity
+
+    for folder in (reports / "gps_qmcpf", reports / "hspf_ungm"):
+        for spec in experiment_configs()[folder.name]["report"].get("tables", []):
+            path = folder / f"{spec['name']}.csv"
+            if "metric" not in spec or not path.exists():
+                continue
+            table = pd.read_csv(path)
+            if "ci_low" not in table or spec.get("kind") == "improvement":
+                continue
+            kind = quantity(spec["metric"]).scaled(spec.get("scale", 1.0))
+            shown = table.dropna(subset=["ci_low", "ci_high"])
+            assert (shown["ci_low"] >= kind.low).all() and (shown["ci_high"] <= kind.high).all(), path
+            assert (shown["ci_low"] <= shown["ours"]).all() and (shown["ours"] <= shown["ci_high"]).all(), path
 
 
 def _pdf_pages_and_text(path: Path) -> tuple[int, str | None]:
@@ -265,6 +309,8 @@ def test_pdf_has_the_summary_then_every_table_and_figure(reports):
     for name, summary in summaries.items():
         assert summary["title"] in flat, name
     assert "Every published cell" in flat and "Table 1: RMSE of the state estimate" in flat
+    assert flat.index("Scorecard") < flat.index("Every published cell")
+    assert "Quick scale" in flat
 
 
 def _valid_png(path: Path) -> tuple[int, int]:

@@ -13,19 +13,12 @@ from omegaconf import DictConfig, OmegaConf
 import replication
 from replication.paths import resolve
 from replication.report.figures import draw
-from replication.report.modes import build_modes_table
-from replication.report.qmc_figures import discrepancies
+from replication.report.claims import evaluate
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
-from replication.report.summary import matched_cells
-from replication.report.tables import (
-    build_improvement_table,
-    build_rating_table,
-    build_summary_table,
-    build_table,
-    format_table,
-)
-from replication.report.verdict import RULES
+from replication.report.scale import scale_changes, scale_note
+from replication.report.tables import TableKind
+from replication.report.verdict import RULES, Verdict
 from replication.runner.config import Run, at_scale
 from replication.runner.store import Store
 
@@ -38,28 +31,16 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     records = store.load(runs)
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, matched, verdicts = [], [], set(), Counter()
-    compared = []  # the published cells our tables matched, with our numbers: reports/index.html's summary
+    tables, figures, built = [], [], {}
     if len(records):
         for table_spec in spec.get("tables", []):
-            if "metrics" in table_spec or table_spec.get("kind") == "discrepancy":  # our numbers only
-                table = (discrepancies(table_spec) if table_spec.get("kind") == "discrepancy"
-                         else build_summary_table(records, table_spec, experiment))
-                csv = f"{table_spec['name']}.csv"
-                table.to_csv(out / csv, index=False)
-                tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html_table(table), "csv": csv})
-                continue
-            build = {"rating": build_rating_table, "improvement": build_improvement_table,
-                     "modes": build_modes_table}.get(table_spec.get("kind"), build_table)
-            table, hits = build(records, table_spec, experiment, published)
+            table = TableKind.of(table_spec, experiment, published).build(records)
             if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
                 continue
-            matched |= hits
-            compared += matched_cells(table, hits, published, table_spec, experiment)
-            verdicts.update(v.split(" (")[0] for v in table["verdict"])
+            built[table_spec["name"]] = table
             csv = f"{table_spec['name']}.csv"
-            table.to_csv(out / csv, index=False)
-            html = html_table(table if table_spec.get("kind") in ("rating", "modes") else format_table(table))
+            table.written().to_csv(out / csv, index=False)
+            html = html_table(table.shown())
             (out / f"{table_spec['name']}.html").write_text(html)
             tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv})
         for figure_spec in spec.get("figures", []):
@@ -67,6 +48,11 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             draw(records, figure_spec, experiment, out / file)
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file})
         records.drop(columns=["per_frame", "strip"], errors="ignore").to_csv(out / "runs.csv", index=False)
+    compared = [entry for table in built.values() for entry in table.cells]
+    matched = {entry["published_index"] for entry in compared}
+    verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
+    claims = evaluate(experiment["name"], experiment, records, built)
+    changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
@@ -86,6 +72,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             if len(unmatched)
             else None,
             rules=RULES,
+            claims=_claims_shown(claims),
+            scale_note=scale_note(cfg.scale, changes),
+            provenance=_provenance(records),
             name=experiment["name"],
             sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),
             command=f"python -m replication experiment={experiment['name']} scale={cfg.scale}",
@@ -102,6 +91,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         "n_runs": len(runs),
         "verdicts": dict(verdicts),
         "cells": compared,
+        "claims": claims,
+        "scale_changes": changes,
         "tables": [{k: t[k] for k in ("name", "title", "csv")} for t in tables],
         "figures": figures,
     }
@@ -121,6 +112,25 @@ def _scenes(experiment: dict) -> list[dict]:
             what = spec.get("stand_in") or "synthetic scene"
             rows.append({"name": name, "kind": "synthetic stand-in", "what": f"{what} ({size}, {spec.get('frames')} frames)"})
     return rows
+
+
+def _claims_shown(claims: dict) -> list[dict]:
+    """Each claim reading tested on this experiment, with its checks, for the page."""
+    return [{"id": claim, "reading": reading, "verdict": Verdict.from_dict(result["verdict"]),
+             "checks": [{**c, "verdict": Verdict.from_dict(c["verdict"])} for c in result["checks"]]}
+            for claim, readings in claims.items() for reading, result in readings.items()]
+
+
+def _provenance(records: pd.DataFrame) -> list[dict]:
+    """Which code and machine computed the stored runs: one row per distinct combination, its runs and dates."""
+    columns = [c for c in ("code_digest", "git_commit", "git_dirty", "python_version", "numpy_version",
+                           "scipy_version", "opencv_version", "numba_version", "machine") if c in records]
+    if not columns or "computed_at" not in records:
+        return []
+    groups = records.assign(**{c: records[c].astype(str) for c in columns}).groupby(columns, sort=False)
+    return [{**dict(zip(columns, key)), "runs": len(group),
+             "computed": f"{group['computed_at'].min()[:16]} to {group['computed_at'].max()[:16]} UTC"}
+            for key, group in groups]
 
 
 def _as_list(value) -> list:

@@ -1,7 +1,9 @@
-"""``reports/index.html``: every published cell against ours, then every experiment with a report, linked.
+"""``reports/index.html``: the scorecard of every paper's claims, every published cell against ours,
+then every experiment with a report, linked.
 
-The summary of every published cell (:mod:`replication.report.summary`) is
-also written as ``reports/summary.csv``.
+The scorecard (:mod:`replication.report.scorecard`) is also written as
+``reports/claims.csv``, and the summary of every published cell
+(:mod:`replication.report.summary`) as ``reports/summary.csv``.
 """
 
 import datetime
@@ -11,9 +13,13 @@ from omegaconf import OmegaConf
 
 import replication
 from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.report.claims import load_papers
 from replication.report.published import load_published
 from replication.report.render import render
+from replication.report.scale import scale_note
+from replication.report.scorecard import claim_rows, claims_frame, owner_of_cells, tally
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table
+from replication.report.verdict import RULES
 
 TITLE = "Particle-filter tracking papers: replication report"
 
@@ -21,6 +27,16 @@ TITLE = "Particle-filter tracking papers: replication report"
 def default_published_values() -> Path:
     """The ``published_values`` of ``conf/config.yaml``, resolved from the project root."""
     return resolve(OmegaConf.load(CONF_DIR / "config.yaml").published_values)
+
+
+def _scale_note(summaries: dict[str, dict]) -> str | None:
+    """The banner when any stored report is below the paper's scale: what quick changes, per experiment."""
+    quick = {name: s for name, s in summaries.items() if s.get("scale") != "paper"}
+    if not quick:
+        return None
+    changes = [f"{name}: {', '.join(s.get('scale_changes', [])) or 'nothing'}" for name, s in quick.items()]
+    return (f"{len(quick)} of {len(summaries)} experiments are at the quick scale. {scale_note('quick')} "
+            f"What it changes: {'; '.join(changes)}.")
 
 
 def write_index(reports: Path, published_values: str | Path | None = None) -> Path:
@@ -36,9 +52,12 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
         entry["ablation"] = "ablation" in name  # the studies on top of the papers get their own section
         experiments.append(entry)
     published = load_published(str(resolve(published_values or default_published_values())))
-    cells = summary_table(published, summaries, experiment_configs())
+    papers = load_papers()
+    rows = claim_rows(papers, summaries)
+    cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
+    claims_frame(rows, published, papers).to_csv(reports / "claims.csv", index=False)
     page = reports / "index.html"
     page.write_text(
         render(
@@ -47,6 +66,10 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             experiments=experiments,
             missing=missing,
             cells=cells.to_dict("records"),
+            papers=[{"paper": paper, "claims": rows[paper.key], "tally": tally(rows[paper.key]),
+                     "cells": int((cells["paper"] == paper.key).sum())} for paper in papers],
+            scale_note=_scale_note(summaries),
+            rules=RULES,
             counts=counts(cells),
             benchmark=(reports / "benchmark" / "index.html").exists(),
             pdf=(reports / "replication.pdf").exists(),

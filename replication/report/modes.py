@@ -8,14 +8,13 @@ counts as two-mode when at least ``mass`` of the marginal lies within
 ``width`` px of each hypothesis, in the frames of ``window`` where the two
 hypotheses are more than 2 ``width`` apart (before that they are one mode).
 A run keeps both modes when most of those frames do; a method does when
-most of its runs do.
+most of its runs do (the table kind ``modes`` in :mod:`replication.report.tables`).
 """
 
 import numpy as np
 import pandas as pd
 
-from replication.report.published import cells
-from replication.report.tracking_figures import _label, _sequence
+from replication.report.tracking_figures import _sequence
 
 
 def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, width: float, mass: float) -> float:
@@ -30,36 +29,16 @@ def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, w
     return float(held.all(axis=1)[apart].mean())
 
 
-def build_modes_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
-    """Per method: the mean share of two-mode frames over runs, runs keeping both modes, and the verdict."""
-    theirs = cells(published, experiment["paper"], spec["paper_table"], spec["paper_metric"])
+def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -> np.ndarray:
+    """Per run of one (method, condition): the share of the window's frames whose marginal of the hidden
+    target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
-    stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
-    rows, matched = [], set()
-    for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
-        sequence, _ = _sequence(experiment, group)
-        axis = "xy".index(group["strip"].iloc[0]["axis"])
-        truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
-        hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
-        shares = np.array([
-            two_mode_share(np.asarray(s["density"])[first - 1 : last], hypotheses, sequence.size[axis], width, mass)
-            for s in group["strip"]
-        ])
-        kept = int((shares > 0.5).sum())
-        ours = "success" if kept > len(shares) / 2 else "failure"
-        wanted = spec.get("match", {}).get(condition, {})
-        hit = theirs[(theirs["method"] == method) & (theirs["experiment"] == wanted.get("experiment", condition))]
-        matched.update(hit.index)
-        paper = hit["value"].iloc[0] if len(hit) else ""
-        rows.append({
-            "method": _label(experiment, method),
-            "condition": condition or "-",
-            "runs": len(shares),
-            "two-mode frames (mean share)": round(float(shares.mean()), 3),
-            "runs keeping both modes": kept,
-            "ours": ours,
-            "paper": paper,
-            "verdict": "reference" if not paper else "agrees" if paper == ours else "differs",
-        })
-    return pd.DataFrame(rows), matched
+    sequence, _ = _sequence(experiment, group)
+    axis = "xy".index(group["strip"].iloc[0]["axis"])
+    truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
+    hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
+    return np.array([
+        two_mode_share(np.asarray(s["density"])[first - 1 : last], hypotheses, sequence.size[axis], width, mass)
+        for s in group["strip"]
+    ])

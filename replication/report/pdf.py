@@ -10,6 +10,7 @@ reports already written, redrawing nothing.
 """
 
 import datetime
+import re
 import sys
 import textwrap
 from functools import lru_cache
@@ -31,19 +32,24 @@ from omegaconf import OmegaConf  # noqa: E402
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
 from replication.report.index import TITLE, default_published_values  # noqa: E402
 from replication.report.published import load_published  # noqa: E402
+from replication.report.claims import load_papers  # noqa: E402
+from replication.report.scale import scale_note  # noqa: E402
+from replication.report.scorecard import claim_rows, owner_of_cells, tally  # noqa: E402
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
-from replication.report.tables import format_table  # noqa: E402
+from replication.report.tables import Table  # noqa: E402
+from replication.report.verdict import RULES  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
-FONT = 6.5  # table text, points: the summary's nine columns
+FONT = 7.0  # table text, points: the smallest that reads in print (a long cell wraps rather than shrinks)
 TABLE_FONT = 7.5  # an experiment's tables
 SPACING = 1.35  # line pitch over the font's height
 PAD = 0.4  # a cell's margin left and right, in em
 BOX = (0.035, 0.05, 0.93, 0.80)  # the table's area on the page: left, bottom, width, height (page fractions)
 SUMMARY_COLUMNS = {  # the summary's columns as printed: heading -> how wide it may get (characters)
     "paper": 10, "table": 5, "experiment / condition": 22, "method": 20, "metric": 21, "paper value": 18,
-    "ours (95% CI)": 34, "verdict or reason": 60, "section": 24,
+    "ours (95% CI)": 34, "verdict or reason": 60, "claim": 26,
 }
+SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (95% CI)": 30, "why": 60, "readings": 40}
 
 
 def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path:
@@ -52,11 +58,19 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     summaries = load_summaries(reports)
     configs = experiment_configs()
     published = load_published(str(resolve(published_values or default_published_values())))
-    cells = summary_table(published, summaries, configs)
+    papers = load_papers()
+    rows = claim_rows(papers, summaries)
+    cells = summary_table(published, summaries, configs, owner_of_cells(papers, published))
     path = reports / "replication.pdf"
     reports.mkdir(parents=True, exist_ok=True)
-    with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), PdfPages(path) as pdf:
-        _title_page(pdf, summaries, cells)
+    with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path) as pdf:
+        _title_page(pdf, summaries, cells, rows)
+        for paper in papers:
+            counted = ", ".join(f"{n} {outcome}" for outcome, n in tally(rows[paper.key]).items())
+            _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key]),
+                         widths=SCORECARD_COLUMNS,
+                         subtitle=f"{paper.authors}; {paper.venue} ({paper.key}). Claims: {counted}.")
+        _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": [RULES]}), widths={"rules": 200})
         _table_pages(pdf, "Every published cell", _summary_frame(cells), widths=SUMMARY_COLUMNS,
                      subtitle="One row per published value: ours and the verdict where a table of ours "
                      "matched it, otherwise why not")
@@ -71,6 +85,7 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
         info["Title"] = TITLE
         info["Subject"] = "The papers' published values against ours, with 95% intervals"
         info["Creator"] = f"replication {replication.__version__}"
+    _outline(path, pdf.marks)
     return path
 
 
@@ -93,9 +108,7 @@ def _figures(folder: Path, summary: dict, config: dict) -> list[dict]:
 
 def _shown(frame: pd.DataFrame) -> pd.DataFrame:
     """A table's CSV as its HTML page shows it: 'mean [low, high]', the paper's value as printed."""
-    judged = {"method", "condition", "runs", "ours", "ci_low", "ci_high", "paper", "verdict"}
-    if judged <= set(frame.columns) and "failed runs" not in frame.columns:
-        frame = format_table(frame.assign(paper=pd.to_numeric(frame["paper"], errors="coerce")))
+    frame = Table.read(frame).shown()
     return frame.map(lambda v: "" if pd.isna(v) else f"{v:.4g}" if isinstance(v, float) else str(v))
 
 
@@ -121,22 +134,35 @@ def _summary_frame(cells: pd.DataFrame) -> pd.DataFrame:
         "paper value": cells["paper_value"],
         "ours (95% CI)": [ours(c) for _, c in cells.iterrows()],
         "verdict or reason": [judged(c) for _, c in cells.iterrows()],
-        "section": cells["link_text"],
+        "claim": cells["claim"],
     })
 
 
-def _title_page(pdf: PdfPages, summaries: dict, cells: pd.DataFrame) -> None:
+def _scorecard_frame(rows) -> pd.DataFrame:
+    """One paper's claims as the scorecard prints them."""
+    return pd.DataFrame({
+        "claim": [f"{r.claim.text} ({r.claim.source})" for r in rows],
+        "verdict": [r.verdict.outcome.value for r in rows],
+        "deciding number (95% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
+        "why": [r.verdict.why for r in rows],
+        "readings": [r.primary.reading.name + ("" if len(r.results) == 1 else f"; {r.robustness}") for r in rows],
+    })
+
+
+def _title_page(pdf: PdfPages, summaries: dict, cells: pd.DataFrame, rows: dict) -> None:
     fig = plt.figure(figsize=PAGE)
     fig.text(0.05, 0.92, TITLE, fontsize=18, weight="bold", va="top")
-    tally = counts(cells)
-    verdicts = ", ".join(f"{k}: {v}" for k, v in tally["verdicts"].items())
+    cell_tally = counts(cells)
+    verdicts = ", ".join(f"{k}: {v}" for k, v in cell_tally["verdicts"].items())
+    claims = [row for paper_rows in rows.values() for row in paper_rows]
+    claim_tally = ", ".join(f"{n} {outcome}" for outcome, n in tally(claims).items())
+    quick = [s for s in summaries.values() if s.get("scale") != "paper"]
     lines = [
         f"Generated {datetime.date.today().isoformat()} by replication {replication.__version__}.",
-        "Each experiment re-runs a published table with independent seeded runs and sets our mean and 95% "
-        "interval beside the paper's value.",
-        f"{tally['cells']} published cells; {tally['compared']} compared with a table of ours"
-        + (f" ({verdicts})" if verdicts else "") + "; the summary that follows says why the others were not.",
-    ]
+        f"{len(claims)} claims of five papers tested ({claim_tally}): the scorecard follows, one page per paper.",
+        f"{cell_tally['cells']} published cells; {cell_tally['compared']} compared with a table of ours"
+        + (f" ({verdicts})" if verdicts else "") + "; the summary after the scorecard says why the others were not.",
+    ] + ([f"{len(quick)} of {len(summaries)} experiments at the quick scale. " + scale_note("quick")] if quick else [])
     fig.text(0.05, 0.85, "\n".join(textwrap.fill(line, 150) for line in lines), fontsize=10, va="top",
              linespacing=1.5, parse_math=False)
     missing = [name for name in experiment_names() if name not in summaries]
@@ -172,7 +198,9 @@ def _figure_page(pdf: PdfPages, heading: str, title: str, png: Path) -> None:
 
 
 def _header(fig, heading: str, subtitle: str | None, width: int = 120) -> None:
-    """The experiment's title and the table's or figure's, wrapped to the page."""
+    """The experiment's title and the table's or figure's, wrapped to the page; both name the page in
+    the PDF outline."""
+    fig.outline = (heading, subtitle)
     top = 1 - 0.035 * PAGE[1] / fig.get_size_inches()[1]
     fig.text(0.035, top, textwrap.fill(heading, width, break_on_hyphens=False), fontsize=12, weight="bold",
              va="top", parse_math=False)
@@ -316,6 +344,42 @@ def _wrap(text: str, width: int) -> str:
 
 def _lines(row: list[str]) -> int:
     return max([1] + [t.count("\n") + 1 for t in row])
+
+
+class _Book(PdfPages):
+    """PdfPages that numbers its pages and remembers each page's place in the outline (its heading and
+    subtitle, as :func:`_header` gave them)."""
+
+    def __init__(self, path: Path):
+        super().__init__(path)
+        self.marks = []  # (heading, subtitle, page index)
+
+    def savefig(self, figure, **kwargs):
+        page = self.get_pagecount()
+        if hasattr(figure, "outline"):
+            self.marks.append((*figure.outline, page))
+        figure.text(0.985, 0.012, f"page {page + 1}", ha="right", va="bottom", fontsize=8, color="#555555")
+        super().savefig(figure, **kwargs)
+
+
+def _outline(path: Path, marks: list[tuple[str, str | None, int]]) -> None:
+    """Give the PDF its outline (bookmarks): a section per heading at its first page, under it an entry
+    per table or figure (its subtitle, without a table's page count); the reader opens it beside page 1."""
+    from pypdf import PdfWriter
+
+    writer = PdfWriter(clone_from=str(path))
+    section, last = None, (None, None)
+    for heading, subtitle, page in marks:
+        subtitle = re.sub(r" \(page \d+ of \d+\)$", "", subtitle or "")
+        if heading != last[0]:
+            section = writer.add_outline_item(title=textwrap.shorten(heading, 100, placeholder=" ..."),
+                                              page_number=page)
+        if subtitle and (heading, subtitle) != last:
+            writer.add_outline_item(title=textwrap.shorten(subtitle, 100, placeholder=" ..."), page_number=page,
+                                    parent=section)
+        last = (heading, subtitle)
+    writer.page_mode = "/UseOutlines"
+    writer.write(str(path))
 
 
 def main(argv: list[str]) -> None:

@@ -1,7 +1,7 @@
 """Every published cell, one row each: ours beside it where a table of ours matched it, otherwise why not.
 
 Each experiment's ``summary.json`` lists, under ``cells``, the published cells
-its tables matched (:func:`matched_cells` builds those entries); this module
+its tables matched (:meth:`replication.report.tables.TableKind.entry` builds those entries); this module
 joins them with ``published_values.csv`` so that the summary at the top of
 ``reports/index.html`` (and the PDF's first pages) has one row per published
 cell, in the file's order.  A cell that no experiment matched still has its
@@ -11,7 +11,6 @@ replicated at all.
 """
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -19,84 +18,8 @@ import pandas as pd
 import yaml
 
 from replication.paths import CONF_DIR, experiment_names
-
-KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
-
-
-# -- what an experiment's report writes -------------------------------------------------------------
-
-
-def matched_cells(
-    table: pd.DataFrame, hits, published: pd.DataFrame, spec: dict, experiment: dict
-) -> list[dict]:
-    """The published cells one report table matched, one JSON-ready entry each, for ``summary.json``.
-
-    ``table`` and ``hits`` are what ``build_table`` / ``build_rating_table`` /
-    ``build_improvement_table`` returned for ``spec``.  Each entry names the cell
-    (``published_index``, its row in ``published_values.csv`` counted from 0
-    after the header, and the key columns :data:`KEYS`) and the row of ours it
-    was compared with: ``table_name``, ``our_method``, ``our_condition``,
-    ``runs``, ``ours``, ``ci_low``, ``ci_high`` (None where undefined, or for a
-    rating), ``verdict``.  A cell two rows of ours matched (two stand-in scenes
-    for one paper scene) has two entries.
-    """
-    hits = sorted(hits)
-    if not hits or table.empty:
-        return []
-    theirs = published.loc[hits]
-    kind = spec.get("kind")
-    key_of = {m.get("label", name): name for name, m in experiment.get("methods", {}).items()}
-    match = {ours: m if isinstance(m, dict) else {"condition": m}
-             for ours, m in spec.get("match", {}).items()}
-    entries, used = [], set()
-    for _, row in table.iterrows():
-        condition = "" if row["condition"] == "-" else row["condition"]
-        if kind == "improvement":  # one row of ours for the paper's one relative claim
-            chosen = theirs
-        else:
-            chosen = theirs[theirs["method"] == key_of.get(row["method"], row["method"])]
-            if kind in ("rating", "modes"):  # text verdicts, matched by scene
-                wanted = match.get(condition, {})
-                chosen = chosen[chosen["experiment"] == wanted.get("experiment", condition)]
-            else:
-                wanted = match.get(condition, {"condition": condition})
-                stated = chosen["condition"].replace("", spec.get("paper_condition", ""))
-                if "condition" in wanted:
-                    chosen = chosen[stated == wanted["condition"]]
-                if "experiment" in wanted:
-                    chosen = chosen[chosen["experiment"] == wanted["experiment"]]
-        for index, cell in chosen.iterrows():
-            used.add(index)
-            entries.append(_entry(index, cell, row, spec["name"], rating=kind in ("rating", "modes")))
-    for index in sorted(set(hits) - used):  # should not happen: matched, but to no row we can tell
-        entries.append({"published_index": int(index), **{k: published.at[index, k] for k in KEYS},
-                        "table_name": spec["name"], "our_method": None, "our_condition": None, "runs": None,
-                        "ours": None, "ci_low": None, "ci_high": None, "verdict": "matched"})
-    return entries
-
-
-def _entry(index, cell: pd.Series, row: pd.Series, table_name: str, rating: bool) -> dict:
-    return {
-        "published_index": int(index),
-        **{k: str(cell[k]) for k in KEYS},
-        "table_name": table_name,
-        "our_method": str(row["method"]),
-        "our_condition": "" if row["condition"] == "-" else str(row["condition"]),
-        "runs": int(row["runs"]),
-        "ours": str(row["ours"]) if rating else _number(row["ours"]),
-        "ci_low": None if rating else _number(row.get("ci_low")),
-        "ci_high": None if rating else _number(row.get("ci_high")),
-        "verdict": str(row["verdict"]),
-    }
-
-
-def _number(value) -> float | None:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None
-
+from replication.report.tables import KEYS
+from replication.report.verdict import Verdict
 
 # -- the summary of every published cell --------------------------------------------------------------
 
@@ -126,13 +49,14 @@ def experiment_configs() -> dict[str, dict]:
 
 
 def summary_table(
-    published: pd.DataFrame, summaries: dict[str, dict], configs: dict[str, dict]
+    published: pd.DataFrame, summaries: dict[str, dict], configs: dict[str, dict], claims: list[str] | None = None
 ) -> pd.DataFrame:
     """One row per published cell (the csv's order): the paper's value, ours and the verdict, or why not.
 
     Columns: the key columns, ``note``, ``paper_value`` (value and unit),
-    ``ours`` ('mean [low, high]', or a rating), ``verdict`` (empty where not
-    compared), ``reason`` (why not compared; empty where compared), ``also``
+    ``ours`` ('mean [low, high]', or a rating), ``outcome`` and ``verdict`` (the
+    outcome and its why; empty where not compared), ``reason`` (why not
+    compared; empty where compared), ``claim`` (the claim the cell belongs to), ``also``
     (further rows of ours compared with the same cell), ``link`` (the
     experiment page's section, relative to ``reports/``) and ``link_text``.
     """
@@ -146,12 +70,12 @@ def summary_table(
         key = tuple(str(cell[k]) for k in KEYS)
         found = by_key.get(key, [])
         row = {k: cell[k] for k in KEYS}
-        row.update(note=cell["note"], paper_value=_paper_value(cell), ours="", verdict="", reason="", also="",
-                   our_condition="", runs="", link="", link_text="")
+        row.update(note=cell["note"], paper_value=_paper_value(cell), ours="", outcome="", verdict="", reason="",
+                   also="", our_condition="", runs="", link="", link_text="", claim=claims[index] if claims else "")
         if found:
             name, summary, entry = found[0]
             row["ours"] = _ours(entry)
-            row["verdict"] = entry["verdict"]
+            row["outcome"], row["verdict"] = _verdict(entry)
             ours_named = entry.get("our_condition") or ""
             if ours_named != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
                 row["our_condition"] = ours_named
@@ -160,7 +84,7 @@ def summary_table(
             row["link_text"] = f"{name}: {entry['table_name']}"
             row["also"] = "; ".join(
                 f"{e.get('table_name')}{' ' + e['our_condition'] if e.get('our_condition') else ''}: "
-                f"{_ours(e)}, {e['verdict']}"
+                f"{_ours(e)}, {_verdict(e)[1]}"
                 for _, _, e in found[1:]
             )
         else:
@@ -168,18 +92,26 @@ def summary_table(
             row["link"] = f"{name}/index.html#unmatched" if name in summaries else ""
             row["link_text"] = name if name in summaries else ""
         rows.append(row)
-    columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "verdict", "reason", "also",
-               "link", "link_text"]
+    columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "reason",
+               "also", "claim", "link", "link_text"]
     return pd.DataFrame(rows, columns=columns)
 
 
 def counts(table: pd.DataFrame) -> dict:
-    """How many cells were compared, with which verdicts, and why the others were not (first words)."""
+    """How many cells were compared, with which outcomes, and why the others were not (first words)."""
     compared = table[table["verdict"] != ""]
-    verdicts = compared["verdict"].map(lambda v: v.split(" (")[0]).value_counts()
+    verdicts = compared["outcome"].value_counts()
     reasons = table[table["reason"] != ""]["reason"].map(lambda r: r.split(":")[0]).value_counts()
     return {"cells": len(table), "compared": len(compared), "verdicts": dict(verdicts.items()),
             "reasons": dict(reasons.items())}
+
+
+def _verdict(entry: dict) -> tuple[str, str]:
+    """(outcome, the verdict as read) of a stored entry; a row of ours without a published number has none."""
+    if not entry.get("verdict"):
+        return "", "no published number"
+    verdict = Verdict.from_dict(entry["verdict"])
+    return verdict.outcome.value, str(verdict)
 
 
 def _paper_value(cell: pd.Series) -> str:

@@ -1,179 +1,331 @@
-"""Paper tables rebuilt from run records: ours (mean, 95% interval) | paper | verdict."""
+"""Report tables rebuilt from run records.  A table kind is a small class named by a spec's ``kind:``.
+
+Every kind turns records into a :class:`Table`: one row per (method,
+condition) of ours, and for the kinds that compare with the paper, the
+published cells each row was matched with (by :func:`match`, the one rule
+for that) and a :class:`~replication.report.verdict.Verdict`.
+
+Add a kind by subclassing :class:`TableKind` with a new ``kind`` name and a
+``build`` method; a spec in ``report.tables`` then names it.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 import pandas as pd
 
-from replication.report.aggregate import comparison_interval, mean_interval, summarise
+from replication.qmc import discrepancy_table
+from replication.report.aggregate import summarise
+from replication.report.modes import runs_keeping_both_modes
 from replication.report.published import cells
-from replication.report.verdict import verdict
+from replication.report.quantities import quantity
+from replication.report.statistics import Estimate, paired_difference, proportion
+from replication.report.verdict import Outcome, Verdict, judge_band, judge_value, too_few
 
 FLOOR_FILTER = "point_mass"
+KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
 
 
-def build_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
-    """Return (table, index labels of the published cells it matched) for one ``report.tables`` entry."""
-    metric, paper_metric = spec["metric"], spec.get("paper_metric", spec["metric"])
-    if "scale" in spec:  # e.g. a share of frames as the paper's percentage
-        records = records.assign(**{metric: records[metric] * spec["scale"]})
-    ours = summarise(records, metric)
-    ours = ours[ours["runs"] > 0].reset_index(drop=True)
-    if spec.get("statistic") == "median":  # timings: the median and its order-statistic interval
-        ours["mean"], ours["ci_low"], ours["ci_high"] = ours["median"], ours["median_low"], ours["median_high"]
-    theirs = cells(published, experiment["paper"], spec["paper_table"], paper_metric).copy()
-    theirs["condition"] = theirs["condition"].replace("", spec.get("paper_condition", ""))
-    # our condition -> the published cell it is compared with: a condition, or {experiment, condition}
-    match = {ours_: m if isinstance(m, dict) else {"condition": m} for ours_, m in spec.get("match", {}).items()}
-    methods = experiment["methods"]
-    paper_runs = spec.get("paper_runs")
-    ours[["cmp_low", "cmp_high"]] = [
-        comparison_interval(m, sd, n, paper_runs) for m, sd, n in zip(ours["mean"], ours["sd"], ours["runs"])
-    ]
-    floor_low, excess = None, {}
-    if metric == "rmse":
-        floors = ours[[methods[m]["filter"] == FLOOR_FILTER for m in ours["method"]]]
-        floor_low = floors["cmp_low"].min() if len(floors) else None
-        excess = excess_over_floor(records, [m for m in methods if methods[m]["filter"] == FLOOR_FILTER])
-    if match:  # a table of the conditions the paper's table covers
-        ours = ours[ours["condition"].isin(list(match))]
-    rows, matched = [], set()
-    for _, row in ours.iterrows():
-        wanted = match.get(row["condition"], {"condition": row["condition"]})
-        chosen = theirs["method"] == row["method"]
-        if "condition" in wanted:
-            chosen &= theirs["condition"] == wanted["condition"]
-        if "experiment" in wanted:
-            chosen &= theirs["experiment"] == wanted["experiment"]
-        hit = theirs[chosen]
-        paper = float(hit["number"].iloc[0]) if len(hit) else np.nan
-        matched.update(hit.index)
-        entry = {
-            "method": methods[row["method"]].get("label", row["method"]),
-            "condition": row["condition"] or "-",
-            "runs": row["runs"],
-            "ours": row["mean"],
-            "ci_low": row["ci_low"],
-            "ci_high": row["ci_high"],
+@dataclass
+class Table:
+    """Rows of ours (``frame``: numbers, and a Verdict per row where compared) and the published cells
+    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell)."""
+
+    frame: pd.DataFrame
+    cells: list[dict] = field(default_factory=list)
+
+    @property
+    def empty(self) -> bool:
+        return self.frame.empty
+
+    def shown(self) -> pd.DataFrame:
+        """The frame as text for a page: 'mean [low, high]', the paper's value, the verdict."""
+        shown = self.frame.drop(columns=["ours", "ci_low", "ci_high", "estimate", "verdict"], errors="ignore")
+        if "estimate" in self.frame:
+            shown.insert(3, "ours (95% CI)", [str(e) for e in self.frame["estimate"]])
+        if "paper" in shown:
+            shown["paper"] = [_printed(v) for v in shown["paper"]]
+        if "verdict" in self.frame:
+            shown["verdict"] = ["" if v is None else str(v) for v in self.frame["verdict"]]
+        return shown
+
+    @classmethod
+    def read(cls, frame: pd.DataFrame) -> "Table":
+        """A table back from the CSV :meth:`written` made (the PDF is drawn from those files)."""
+        frame = frame.copy()
+        if {"ours", "ci_low", "ci_high", "runs", "interval"} <= set(frame.columns):
+            frame["estimate"] = [Estimate(*row[:4], "" if pd.isna(row[4]) else row[4]) for row in
+                                 frame[["ours", "ci_low", "ci_high", "runs", "interval"]].itertuples(index=False)]
+        if {"outcome", "why"} <= set(frame.columns):
+            frame["verdict"] = [Verdict(Outcome(o), "" if pd.isna(w) else w) if isinstance(o, str) and o else None
+                                for o, w in zip(frame.pop("outcome"), frame.pop("why"))]
+        return cls(frame)
+
+    def written(self) -> pd.DataFrame:
+        """The frame for a CSV: numbers as numbers, the verdict as its outcome and why."""
+        frame = self.frame.drop(columns=["estimate"], errors="ignore").copy()
+        if "verdict" in frame:
+            frame["outcome"] = [v.outcome.value if v else "" for v in frame["verdict"]]
+            frame["why"] = [v.why if v else "" for v in frame["verdict"]]
+            frame = frame.drop(columns=["verdict"])
+        return frame
+
+
+def match(theirs: pd.DataFrame, method: str, condition: str, spec: dict) -> pd.DataFrame:
+    """The published cells our row (``method``, ``condition``) is compared with.
+
+    ``spec.match`` maps a condition of ours to the paper's: a condition
+    string, or ``{experiment: scene, condition: ...}``; an unmapped condition
+    is compared with the paper's of the same name.  A paper cell with no
+    condition takes ``spec.paper_condition`` (the paper's unstated N, say).
+    """
+    wanted = spec.get("match", {}).get(condition, {"condition": condition})
+    wanted = wanted if isinstance(wanted, dict) else {"condition": wanted}
+    chosen = theirs["method"] == method
+    if "condition" in wanted:
+        chosen &= theirs["condition"].replace("", spec.get("paper_condition", "")) == wanted["condition"]
+    if "experiment" in wanted:
+        chosen &= theirs["experiment"] == wanted["experiment"]
+    return theirs[chosen]
+
+
+class TableKind:
+    """One kind of report table; subclasses register themselves by ``kind``."""
+
+    kind: ClassVar[str]
+    compares: ClassVar[bool] = True  # whether its rows are matched with published cells
+    registry: ClassVar[dict[str, type["TableKind"]]] = {}
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        TableKind.registry[cls.kind] = cls
+
+    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame):
+        self.spec, self.experiment, self.published = spec, experiment, published
+
+    @classmethod
+    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame) -> "TableKind":
+        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison)."""
+        name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
+        if name not in cls.registry:
+            raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
+        return cls.registry[name](spec, experiment, published)
+
+    def build(self, records: pd.DataFrame) -> Table:
+        raise NotImplementedError
+
+    def label(self, method: str) -> str:
+        return self.experiment["methods"].get(method, {}).get("label", method)
+
+    def theirs(self) -> pd.DataFrame:
+        spec = self.spec
+        return cells(self.published, self.experiment["paper"], spec["paper_table"],
+                     spec.get("paper_metric", spec.get("metric")))
+
+    def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, ours=None) -> dict:
+        """A matched published cell for ``summary.json``: the cell's keys and our row's numbers."""
+        cell = self.published.loc[index]
+        return {
+            "published_index": int(index),
+            **{k: str(cell[k]) for k in KEYS},
+            "table_name": self.spec["name"],
+            "our_method": row["method"],
+            "our_condition": "" if row["condition"] == "-" else row["condition"],
+            "runs": int(row["runs"]),
+            "ours": ours if ours is not None else _number(estimate.value),
+            "ci_low": _number(estimate.low) if estimate else None,
+            "ci_high": _number(estimate.high) if estimate else None,
+            "interval": estimate.method if estimate else "",
+            "verdict": verdict.as_dict() if verdict else None,
         }
-        if excess:
-            entry["excess_over_floor"], entry["excess_ci_low"], entry["excess_ci_high"] = excess.get(
-                (row["method"], row["condition"]), (np.nan, np.nan, np.nan)
-            )
-        if spec.get("show_variance"):
-            entry["variance"] = row["variance"]
-        entry["paper"] = paper
-        entry["verdict"] = verdict(paper, row["mean"], row["cmp_low"], row["cmp_high"], paper_metric, floor_low)
-        rows.append(entry)
-    return pd.DataFrame(rows), matched
 
 
-def stability(failures: int, runs: int) -> str:
-    """bis_pf's rating over (nominally 10) runs: good = no failure, medium = 2 or more, poor = 5 or more."""
-    scaled = failures * 10 / runs  # the rule is stated per 10 runs
-    return "poor" if scaled >= 5 else "medium" if scaled >= 2 else "good"
+class Comparison(TableKind):
+    """Ours (a statistic with its 95% interval) beside the paper's number, judged (Tables 1-4 of most papers)."""
+
+    kind = "comparison"
+
+    def build(self, records: pd.DataFrame) -> Table:
+        spec, methods = self.spec, self.experiment["methods"]
+        metric, paper_metric = spec["metric"], spec.get("paper_metric", spec["metric"])
+        kind = quantity(paper_metric if quantity(paper_metric).machine_dependent else metric)
+        kind = kind.scaled(spec.get("scale", 1.0))
+        ours = summarise(records, metric, spec.get("scale", 1.0), spec.get("statistic", "mean"))
+        ours = ours[ours["runs"] > 0]
+        floor_low, excess = None, {}
+        if metric == "rmse":
+            floor = [m for m in methods if methods[m]["filter"] == FLOOR_FILTER]
+            floors = ours[ours["method"].isin(floor)]
+            floor_low = floors["ci_low"].min() if len(floors) else None
+            excess = excess_over_floor(records, floor)
+        if spec.get("match"):  # the conditions the paper's table covers
+            ours = ours[ours["condition"].isin(list(spec["match"]))]
+        theirs = self.theirs()
+        rows, entries = [], []
+        for _, row in ours.iterrows():
+            estimate = Estimate(row["mean"], row["ci_low"], row["ci_high"], row["runs"], row["interval"])
+            hit = match(theirs, row["method"], row["condition"], spec)
+            paper = float(hit["number"].iloc[0]) if len(hit) else math.nan
+            verdict = judge_value(paper, estimate, kind, spec.get("paper_runs"), floor_low)
+            shown = {"method": self.label(row["method"]), "condition": row["condition"] or "-",
+                     "runs": row["runs"], "estimate": estimate, "ours": row["mean"], "ci_low": row["ci_low"],
+                     "ci_high": row["ci_high"], "interval": row["interval"]}
+            if excess:
+                shown["excess over the floor (paired, 95% CI)"] = str(
+                    excess.get((row["method"], row["condition"]), ""))
+            if spec.get("show_variance"):
+                shown["variance over runs"] = row["variance"]
+            shown.update(paper=paper, verdict=verdict)
+            rows.append(shown)
+            entries += [self.entry(i, shown, verdict, estimate) for i in hit.index]
+        return Table(pd.DataFrame(rows), entries)
 
 
-def build_rating_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
-    """Failed runs and the paper's stability rating per method and condition (bis_pf Table 3)."""
-    theirs = cells(published, experiment["paper"], spec["paper_table"], spec["paper_metric"])
-    match = spec.get("match", {})
-    rows, matched = [], set()
-    for (method, condition), group in records.groupby(["method", "condition"], sort=False):
-        failures, runs = int(group[spec["metric"]].sum()), len(group)
-        ours = stability(failures, runs)
-        wanted = match.get(condition, {})
-        hit = theirs[(theirs["method"] == method) & (theirs["experiment"] == wanted.get("experiment", condition))]
-        matched.update(hit.index)
-        paper = hit["value"].iloc[0] if len(hit) else ""
-        rows.append(
-            {
-                "method": experiment["methods"][method].get("label", method),
-                "condition": condition or "-",
-                "runs": runs,
-                "failed runs": failures,
-                "ours": ours,
-                "paper": paper,
-                "verdict": "reference" if not paper else "agrees" if paper == ours else "differs",
-            }
-        )
-    return pd.DataFrame(rows), matched
+def stability_bands(per: int = 10) -> dict[str, tuple[float, float]]:
+    """bis_pf's ratings as bands of the failure probability: good = no failure in 10 runs, medium = 2 or
+    more, poor = 5 or more; one failure in 10 (unrated by the paper) is split between good and medium."""
+    return {"good": (0.0, 1.5 / per), "medium": (1.5 / per, 4.5 / per), "poor": (4.5 / per, 1.0)}
 
 
-def build_summary_table(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
-    """One row per method and condition, one column per metric: 'mean [95% CI]' over runs."""
-    columns = {}
-    for metric in spec["metrics"]:
-        summary = summarise(records, metric)
-        columns[metric] = {
-            (m, c): f"{mean:.4g} [{lo:.4g}, {hi:.4g}]" if np.isfinite(lo) else f"{mean:.4g}"
-            for m, c, mean, lo, hi in zip(summary["method"], summary["condition"], summary["mean"], summary["ci_low"], summary["ci_high"])
-        }
-    keys = list(columns[spec["metrics"][0]])
-    table = pd.DataFrame(
-        {
-            "method": [experiment["methods"][m].get("label", m) for m, _ in keys],
-            "condition": [c or "-" for _, c in keys],
-            "runs": [int((records["method"] == m).where(records["condition"] == c, False).sum()) for m, c in keys],
-        }
-    )
-    for metric, values in columns.items():
-        table[metric] = [values.get(key, "") for key in keys]
-    return table
+class Rating(TableKind):
+    """Failed runs per method and condition, the rating they give, and the paper's (bis_pf Table 3)."""
+
+    kind = "rating"
+
+    def build(self, records: pd.DataFrame) -> Table:
+        theirs, bands = self.theirs(), stability_bands()
+        rows, entries = [], []
+        for (method, condition), group in records.groupby(["method", "condition"], sort=False):
+            failures, runs = int(group[self.spec["metric"]].sum()), len(group)
+            estimate = proportion(failures, runs)
+            hit = match(theirs, method, condition, self.spec)
+            paper = hit["value"].iloc[0] if len(hit) else ""
+            ours = next(name for name, (low, high) in bands.items() if low <= estimate.value <= high)
+            verdict = judge_band(paper, estimate, bands) if paper else None
+            row = {"method": self.label(method), "condition": condition or "-", "runs": runs,
+                   "failed runs": failures, "failure rate (Wilson 95% CI)": str(estimate), "rating": ours,
+                   "paper": paper, "verdict": verdict}
+            rows.append(row)
+            entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
+        return Table(pd.DataFrame(rows), entries)
+
+
+class Modes(TableKind):
+    """Does a hidden target's posterior keep both hypotheses?  Runs that do, per method (bis_pf's 3123 text)."""
+
+    kind = "modes"
+    BANDS = {"success": (0.5, 1.0), "failure": (0.0, 0.5)}  # most runs keep both modes, or most do not
+
+    def build(self, records: pd.DataFrame) -> Table:
+        theirs = self.theirs()
+        stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
+        rows, entries = [], []
+        for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
+            shares = runs_keeping_both_modes(group, self.spec, self.experiment)
+            estimate = proportion(int((shares > 0.5).sum()), len(shares))
+            hit = match(theirs, method, condition, self.spec)
+            paper = hit["value"].iloc[0] if len(hit) else ""
+            ours = "success" if estimate.value > 0.5 else "failure"
+            verdict = judge_band(paper, estimate, self.BANDS) if paper else None
+            row = {"method": self.label(method), "condition": condition or "-", "runs": len(shares),
+                   "two-mode frames (mean share)": round(float(shares.mean()), 3),
+                   "runs keeping both modes (Wilson 95% CI)": str(estimate), "ours": ours, "paper": paper,
+                   "verdict": verdict}
+            rows.append(row)
+            entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
+        return Table(pd.DataFrame(rows), entries)
+
+
+class Improvement(TableKind):
+    """A paper's relative claim, 100 (metric[baseline] - metric[method]) / mean metric[baseline] in %,
+    from paired runs (both methods filter the same data at a repetition): hspf's 1.8 %."""
+
+    kind = "improvement"
+
+    def build(self, records: pd.DataFrame) -> Table:
+        spec = self.spec
+        metric, baseline, method = spec["metric"], spec["baseline"], spec["method"]
+        paired = pair(records, metric, baseline, method)
+        if paired.empty:
+            return Table(pd.DataFrame())
+        scale = 100.0 / paired["baseline"].mean()
+        estimate = paired_difference(paired["baseline"], paired["method"]).scaled(scale)
+        theirs = self.theirs()
+        paper = float(theirs["number"].iloc[0]) if len(theirs) else math.nan
+        verdict = too_few(estimate.runs) or judge_value(paper, estimate, quantity("improvement"))
+        if verdict and verdict.outcome is Outcome.REPRODUCED and estimate.low <= 0:
+            verdict = Verdict(Outcome.INCONCLUSIVE, "the interval holds the paper's value and no improvement")
+        row = {"method": f"{self.label(method)} vs {self.label(baseline)}", "condition": "-",
+               "runs": estimate.runs, "estimate": estimate, "ours": estimate.value, "ci_low": estimate.low,
+               "ci_high": estimate.high, "interval": estimate.method, "paper": paper, "verdict": verdict}
+        return Table(pd.DataFrame([row]), [self.entry(i, row, verdict, estimate) for i in theirs.index])
+
+
+class Summary(TableKind):
+    """Ours only: one row per method and condition, one column per metric, 'mean [95% CI]'."""
+
+    kind = "summary"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        columns = {metric: summarise(records, metric) for metric in self.spec["metrics"]}
+        first = columns[self.spec["metrics"][0]]
+        table = pd.DataFrame({"method": [self.label(m) for m in first["method"]],
+                              "condition": [c or "-" for c in first["condition"]], "runs": first["runs"]})
+        for metric, summary in columns.items():
+            table[metric] = [str(Estimate(*values, "")) for values in
+                             zip(summary["mean"], summary["ci_low"], summary["ci_high"], summary["runs"])]
+        return Table(table)
+
+
+class Discrepancy(TableKind):
+    """gps_qmcpf Figures 1-3's point sets: centred L2 discrepancy of random, Halton and good points."""
+
+    kind = "discrepancy"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        spec = self.spec
+        return Table(discrepancy_table(n=int(spec.get("n", 400)), dims=tuple(spec.get("dims", (2, 3, 5))),
+                                       method=spec.get("method", "CD")))
+
+
+def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
+    """``metric`` of two methods run on the same data (same data condition and repetition), side by side:
+    columns ``baseline`` and ``method``, one row per shared repetition (at ``condition`` if given)."""
+    columns = ["data_condition", "repetition", metric]
+    chosen = records if condition is None else records[records["condition"] == condition]
+    left = chosen[chosen["method"] == baseline][columns]
+    right = chosen[chosen["method"] == method][columns]
+    paired = left.merge(right, on=["data_condition", "repetition"], suffixes=("_baseline", "_method"))
+    return pd.DataFrame({"baseline": paired[f"{metric}_baseline"].astype(float),
+                         "method": paired[f"{metric}_method"].astype(float)})
 
 
 def excess_over_floor(records: pd.DataFrame, floor_methods: list[str]) -> dict:
-    """Paired RMSE minus the point-mass filter's RMSE on the same trajectory: mean and 95% interval.
-
-    Every method filters the same data at a given repetition, so the paired
-    difference isolates the filter's own error from the run-to-run spread.
-    """
+    """Paired RMSE minus the point-mass filter's RMSE on the same trajectory: an Estimate per (method,
+    condition).  Every method filters the same data at a repetition, so the paired difference isolates
+    the filter's own error from the run-to-run spread."""
     floor = records[records["method"].isin(floor_methods)][["data_condition", "repetition", "rmse"]]
     if floor.empty:
         return {}
     paired = records.merge(floor, on=["data_condition", "repetition"], suffixes=("", "_floor"))
     paired = paired[~paired["method"].isin(floor_methods)]
-    return {
-        key: mean_interval(group["rmse"] - group["rmse_floor"])
-        for key, group in paired.groupby(["method", "condition"], sort=False)
-    }
+    return {key: paired_difference(group["rmse"], group["rmse_floor"])
+            for key, group in paired.groupby(["method", "condition"], sort=False)}
 
 
-def format_table(table: pd.DataFrame) -> pd.DataFrame:
-    """Numbers as text for HTML: 'mean [low, high]' and the paper's value as printed."""
-    shown = pd.DataFrame({"method": table["method"], "condition": table["condition"], "runs": table["runs"]})
-    shown["ours (95% CI)"] = [
-        f"{m:.4g} [{lo:.4g}, {hi:.4g}]" if np.isfinite(lo) else f"{m:.4g}"
-        for m, lo, hi in zip(table["ours"], table["ci_low"], table["ci_high"])
-    ]
-    if "excess_over_floor" in table:
-        shown["excess over the floor (paired, 95% CI)"] = [
-            "" if not np.isfinite(m) else f"{m:+.3g} [{lo:+.3g}, {hi:+.3g}]"
-            for m, lo, hi in zip(table["excess_over_floor"], table["excess_ci_low"], table["excess_ci_high"])
-        ]
-    if "variance" in table:
-        shown["variance over runs"] = table["variance"].map(lambda v: f"{v:.4g}")
-    shown["paper"] = table["paper"].map(lambda v: "" if np.isnan(v) else f"{v:g}")
-    shown["verdict"] = table["verdict"]
-    return shown
+def _printed(value) -> str:
+    if isinstance(value, str):
+        return value
+    return "" if value is None or not np.isfinite(value) else f"{value:g}"
 
 
-def build_improvement_table(records: pd.DataFrame, spec: dict, experiment: dict, published: pd.DataFrame):
-    """A paper's relative claim: 100 (metric[baseline] - metric[method]) / mean metric[baseline], paired by run.
-
-    Both methods filter the same data at a repetition, so the interval is the
-    t-interval of the paired differences, scaled by the baseline's mean.
-    """
-    metric, baseline, method = spec["metric"], spec["baseline"], spec["method"]
-    columns = ["data_condition", "repetition", metric]
-    paired = records[records["method"] == baseline][columns].merge(
-        records[records["method"] == method][columns], on=["data_condition", "repetition"], suffixes=("_base", "")
-    )
-    if paired.empty:
-        return pd.DataFrame(), set()
-    scale = 100.0 / paired[f"{metric}_base"].mean()
-    mean, low, high = (scale * v for v in mean_interval(paired[f"{metric}_base"] - paired[metric]))
-    theirs = cells(published, experiment["paper"], spec["paper_table"], spec["paper_metric"])
-    paper = float(theirs["number"].iloc[0]) if len(theirs) else np.nan
-    label = f"{experiment['methods'][method].get('label', method)} vs {experiment['methods'][baseline].get('label', baseline)}"
-    row = {"method": label, "condition": "-", "runs": len(paired), "ours": mean, "ci_low": low, "ci_high": high,
-           "paper": paper, "verdict": verdict(paper, mean, low, high, spec["paper_metric"])}
-    return pd.DataFrame([row]), set(theirs.index)
+def _number(value) -> float | None:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) else None

@@ -1,0 +1,83 @@
+"""What each per-run metric is: its range, which way is better, its interval, its human label.
+
+A record's metric names are the compute side's (``rmse``,
+``correct_frames[iou>=0.5]``); this is the one place the report says what
+kind of number each is, so that an interval fits its quantity:
+
+* ``binary``: a per-run yes/no outcome (a run failed, a target was tracked to
+  the end); its mean over runs is a proportion: Wilson interval.
+* ``bounded``: a per-run share or score with a range (share of correct frames,
+  precision, AUC, MOTA <= 1): BCa bootstrap over runs, clipped to the range.
+* ``positive``: non-negative and usually skewed (errors, counts, ESS): BCa
+  bootstrap over runs, clipped at 0.
+* ``real``: anything else (a signed deviation): BCa bootstrap over runs.
+* ``timing``: machine-dependent; its interval is the same bootstrap, and a
+  published timing is shown with the ratio ours / theirs, never judged.
+"""
+
+import math
+import re
+from dataclasses import dataclass, replace
+
+
+@dataclass(frozen=True)
+class Quantity:
+    kind: str  # binary | bounded | positive | real | timing
+    low: float = 0.0
+    high: float = math.inf
+    lower_is_better: bool = True
+    label: str = ""
+
+    def scaled(self, factor: float) -> "Quantity":
+        """The same quantity in other units (a share as a percentage: factor 100)."""
+        return replace(self, low=self.low * factor, high=self.high * factor)
+
+    @property
+    def proportion(self) -> bool:
+        return self.kind == "binary"
+
+    @property
+    def machine_dependent(self) -> bool:
+        return self.kind == "timing"
+
+
+_BINARY = Quantity("binary", 0.0, 1.0)
+_SHARE = Quantity("bounded", 0.0, 1.0, lower_is_better=False)
+
+QUANTITIES = {
+    "rmse": Quantity("positive", label="RMSE"),
+    "mean_cle": Quantity("positive", label="mean centre location error (px)"),
+    "visible_error": Quantity("positive", label="mean error while visible (px)"),
+    "mean_error_per_target": Quantity("positive", label="mean error per target (px)"),
+    "lost_targets": Quantity("positive", label="targets lost"),
+    "switches": Quantity("positive", label="identity switches"),
+    "degenerate_steps": Quantity("positive", label="degenerate steps"),
+    "resample_count": Quantity("positive", label="resamplings"),
+    "mean_ess": Quantity("positive", lower_is_better=False, label="mean ESS (particles)"),
+    "resample_rate": Quantity("bounded", 0.0, 100.0, label="resampling rate (%)"),
+    "precision20": replace(_SHARE, label="precision at 20 px"),
+    "success_auc": replace(_SHARE, label="success AUC"),
+    "mota": Quantity("bounded", -math.inf, 1.0, lower_is_better=False, label="MOTA"),
+    "failed": replace(_BINARY, label="runs failed"),
+    "ms_per_frame": Quantity("timing", label="time per frame (ms)"),
+    "ms_per_step": Quantity("timing", label="time per step (ms)"),
+    "filter_s": Quantity("timing", label="filtering time (s)"),
+    "wall_s": Quantity("timing", label="wall time (s)"),
+    "fps": Quantity("timing", lower_is_better=False, label="frames per second"),
+}
+_PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_to_end[cle<=20]
+    (re.compile(r"correct_frames\[(.+)\]"), lambda rule: replace(_SHARE, label=f"share of frames with {rule}")),
+    (re.compile(r"tracked_to_end\[(.+)\]"), lambda rule: replace(_BINARY, lower_is_better=False,
+                                                                 label=f"runs tracked to the end ({rule})")),
+)
+
+
+def quantity(metric: str) -> Quantity:
+    """The quantity a metric is; an unknown metric is taken as an unbounded real number."""
+    if metric in QUANTITIES:
+        return QUANTITIES[metric]
+    for pattern, make in _PATTERNS:
+        found = pattern.fullmatch(metric)
+        if found:
+            return make(found[1])
+    return Quantity("real", -math.inf, math.inf, label=metric)

@@ -1,0 +1,41 @@
+"""What the quick scale changes from the paper's, said on every page and in the PDF.
+
+An experiment config writes ``{paper: a, quick: b}`` wherever the scale
+matters (run counts, frames of a scene, the last frame of a real sequence);
+:func:`scale_changes` lists those, so the banner cannot fall out of step with
+the configs.
+"""
+
+PAPER_COMMAND = "make replicate SCALE=paper"
+
+
+def scale_changes(config: dict, path: str = "") -> list[str]:
+    """Every ``{paper: a, quick: b}`` in an experiment config (before its scale is applied), as
+    ``'<where>: a -> b'`` (``all`` for a null: every frame)."""
+    if isinstance(config, dict):
+        if set(config) == {"paper", "quick"}:
+            shown = ["all" if v is None else str(v) for v in (config["paper"], config["quick"])]
+            return [f"{_where(path)}: {shown[0]} -> {shown[1]}"] if shown[0] != shown[1] else []
+        return [change for key, value in config.items() for change in scale_changes(value, f"{path}.{key}")]
+    if isinstance(config, list):
+        return [change for i, value in enumerate(config) for change in scale_changes(value, f"{path}[{i}]")]
+    return []
+
+
+def _where(path: str) -> str:
+    """A config path as a reader says it: 'runs', 'scene exp2_16_targets frames', 'scene Girl last frame'."""
+    parts = path.strip(".").split(".")
+    if parts[0] == "scenes" and len(parts) >= 3:
+        what = {"frames": "frames", "last": "last frame"}.get(parts[-1], parts[-1])
+        return f"scene {parts[1]} {what}"
+    return " ".join(parts)
+
+
+def scale_note(scale: str, changes: list[str] | None = None) -> str | None:
+    """The banner of a page at ``scale`` (None at the paper's), listing ``changes`` where given."""
+    if scale == "paper":
+        return None
+    listed = "" if changes is None else f" ({'; '.join(changes) or 'for this experiment, nothing'})"
+    return (f"Quick scale: fewer runs and shorter scenes than the papers'{listed}. Intervals are wider, "
+            f"verdicts from fewer than 5 runs are 'not testable', and rankings over truncated sequences can "
+            f"differ from full-length ones. Paper scale: {PAPER_COMMAND}.")

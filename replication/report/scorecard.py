@@ -1,0 +1,105 @@
+"""The scorecard: each paper's claims with their verdicts, from the results the experiment reports stored.
+
+Each experiment's ``summary.json`` holds, under ``claims``, the result of
+every reading that names it (:func:`replication.report.claims.evaluate`).
+Here they are gathered per claim: the primary reading's verdict, the number
+that decided it with its interval, one line of why, and whether the verdict
+survives the other readings.  ``reports/claims.csv`` is the same, one row
+per claim.
+"""
+
+from collections import Counter
+from dataclasses import dataclass
+
+import pandas as pd
+
+from replication.report.claims import Claim, Paper, Reading
+from replication.report.verdict import Outcome, Verdict
+
+
+@dataclass(frozen=True)
+class ReadingResult:
+    reading: Reading
+    verdict: Verdict
+    deciding: dict | None  # the deciding check as stored: what, number, value, low, high, runs
+    checks: tuple[dict, ...]
+    scale: str
+
+
+@dataclass(frozen=True)
+class ClaimRow:
+    claim: Claim
+    results: tuple[ReadingResult, ...]
+
+    @property
+    def primary(self) -> ReadingResult:
+        return self.results[0]
+
+    @property
+    def verdict(self) -> Verdict:
+        return self.primary.verdict
+
+    @property
+    def robustness(self) -> str:
+        """Whether the verdict is the same under every reading, or which reading it hinges on."""
+        judged = [r for r in self.results if r.verdict.outcome is not Outcome.NOT_TESTABLE]
+        if len(self.results) == 1:
+            return "one reading"
+        if len(judged) < 2:
+            return "other readings not testable"
+        outcomes = {r.verdict.outcome for r in judged}
+        if len(outcomes) == 1:
+            return f"the same under all {len(judged)} readings"
+        return "hinges on the reading: " + "; ".join(f"{r.verdict.outcome.value} under {r.reading.name}"
+                                                     for r in judged)
+
+
+def claim_rows(papers: list[Paper], summaries: dict[str, dict]) -> dict[str, list[ClaimRow]]:
+    """Per paper, its claims with every reading's stored result (not testable where none is stored)."""
+    return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings))
+                        for claim in paper.claims] for paper in papers}
+
+
+def _result(claim: Claim, reading: Reading, summaries: dict[str, dict]) -> ReadingResult:
+    summary = summaries.get(reading.experiment)
+    if summary is None:
+        return ReadingResult(reading, Verdict(Outcome.NOT_TESTABLE, f"not run yet: experiment={reading.experiment}"),
+                             None, (), "")
+    stored = summary.get("claims", {}).get(claim.id, {}).get(reading.name)
+    if stored is None:
+        why = f"no result stored: python -m replication.report experiment={reading.experiment}"
+        return ReadingResult(reading, Verdict(Outcome.NOT_TESTABLE, why), None, (), summary.get("scale", ""))
+    return ReadingResult(reading, Verdict.from_dict(stored["verdict"]), stored.get("deciding"),
+                         tuple(stored.get("checks", ())), summary.get("scale", ""))
+
+
+def tally(rows: list[ClaimRow]) -> dict[str, int]:
+    """How many claims have each outcome, in the outcomes' order."""
+    counted = Counter(row.verdict.outcome for row in rows)
+    return {outcome.value: counted[outcome] for outcome in Outcome if counted[outcome]}
+
+
+def owner_of_cells(papers: list[Paper], published: pd.DataFrame) -> list[str]:
+    """For each published cell (the csv's order), the id of the claim it belongs to ('' if none)."""
+    claims = [claim for paper in papers for claim in paper.claims]
+    return [next((c.id for c in claims if c.owns(cell)), "") for _, cell in published.iterrows()]
+
+
+def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, papers: list[Paper]) -> pd.DataFrame:
+    """``reports/claims.csv``: one row per claim with its verdict, deciding number and interval, runs,
+    why, robustness across readings, and the published cells it owns."""
+    owners = owner_of_cells(papers, published)
+    table = []
+    for paper, claims in rows.items():
+        for row in claims:
+            deciding = row.primary.deciding or {}
+            table.append({
+                "paper": paper, "claim_id": row.claim.id, "claim": row.claim.text, "source": row.claim.source,
+                "verdict": row.verdict.outcome.value, "reason": row.verdict.why,
+                "number": deciding.get("value"), "ci_low": deciding.get("low"), "ci_high": deciding.get("high"),
+                "runs": deciding.get("runs"), "deciding": deciding.get("what", ""),
+                "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
+                "scale": row.primary.scale,
+                "cells": sum(owner == row.claim.id for owner in owners),
+            })
+    return pd.DataFrame(table)

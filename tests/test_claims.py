@@ -1,0 +1,124 @@
+"""The papers' claims as data, and the tests that judge them, on hand cases."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from hydra import compose, initialize_config_dir
+from omegaconf import OmegaConf
+
+from replication.paths import CONF_DIR, resolve
+from replication.report.claims import Check, ClaimTest, Result, load_papers
+from replication.report.published import load_published
+from replication.report.statistics import Estimate
+from replication.report.verdict import Outcome, Verdict
+
+PUBLISHED = resolve("../shared/reference/published_values.csv")
+PAPERS = load_papers()
+
+
+def test_every_published_cell_belongs_to_exactly_one_claim():
+    if not PUBLISHED.exists():
+        pytest.skip("../shared is not beside the project")
+    published = load_published(str(PUBLISHED))
+    claims = [c for p in PAPERS for c in p.claims]
+    for _, cell in published.iterrows():
+        owners = [c.id for c in claims if c.owns(cell)]
+        assert len(owners) == 1, (dict(cell[["paper", "table", "experiment", "method", "metric"]]), owners)
+
+
+def test_every_reading_names_a_real_experiment_methods_and_tables():
+    assert {p.key for p in PAPERS} == {"ism_pf", "gps_qmcpf", "bis_pf", "fusion_pf", "hspf"}
+    assert len({c.id for p in PAPERS for c in p.claims}) == sum(len(p.claims) for p in PAPERS)
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        for paper in PAPERS:
+            for claim in paper.claims:
+                assert claim.id.startswith(f"{paper.key}.") and claim.readings, claim.id
+                for reading in claim.readings:
+                    experiment = OmegaConf.to_container(
+                        compose("config", overrides=[f"experiment={reading.experiment}"]).experiment)
+                    assert experiment["paper"] == paper.key, claim.id
+                    test = reading.test
+                    ClaimTest.of(test, experiment)  # a known test
+                    named = [m for g in test.get("order", []) for m in ([g] if isinstance(g, str) else g)]
+                    named += [test["method"]] if "method" in test else []
+                    assert set(named) <= set(experiment["methods"]), (claim.id, reading.name)
+                    tables = {t["name"] for t in experiment["report"]["tables"]}
+                    assert set(test.get("tables", [])) <= tables, (claim.id, reading.name)
+
+
+EXPERIMENT = {"methods": {"A": {}, "B": {}, "C": {}}}
+
+
+def _records(effects: dict[str, float], runs: int = 20, metric: str = "rmse", noise: float = 0.1) -> pd.DataFrame:
+    """Three methods on common data: run r of every method shares a base value, plus the method's effect."""
+    rng = np.random.default_rng(1)
+    base = rng.normal(5.0, 1.0, runs)
+    return pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
+                          metric: base[r] + effect + noise * rng.standard_normal()}
+                         for m, effect in effects.items() for r in range(runs)])
+
+
+def _verdict(spec: dict, records: pd.DataFrame) -> Verdict:
+    return Result.of(ClaimTest.of(spec, EXPERIMENT).checks(records, {})).verdict
+
+
+def test_order_uses_paired_differences():
+    # the run-to-run spread (sd 1) dwarfs the effects (0.2): only pairing by run can resolve them
+    records = _records({"A": 0.0, "B": 0.2, "C": 0.4})
+    assert _verdict({"test": "order", "metric": "rmse", "order": ["A", "B", "C"]}, records).outcome \
+        is Outcome.REPRODUCED
+    backwards = _verdict({"test": "order", "metric": "rmse", "order": ["C", "A"]}, records)
+    assert backwards == Verdict(Outcome.NOT_REPRODUCED, backwards.why) and "C - A at N=1" in backwards.why
+    tied = _records({"A": 0.0, "B": 0.0})
+    assert _verdict({"test": "order", "metric": "rmse", "order": ["A", "B"]}, tied).outcome is Outcome.INCONCLUSIVE
+    # "no slower than by more than 10 %": B is 4 % worse than A
+    assert _verdict({"test": "order", "metric": "rmse", "order": ["B", "A"], "tolerance": 0.1}, records).outcome \
+        is Outcome.REPRODUCED
+    higher = _records({"A": 1.0, "B": 0.0}, metric="mean_ess")  # higher is better for ESS
+    assert _verdict({"test": "order", "metric": "mean_ess", "order": ["A", "B"]}, higher).outcome \
+        is Outcome.REPRODUCED
+    few = _records({"A": 0.0, "B": 1.0}, runs=4)
+    assert _verdict({"test": "order", "metric": "rmse", "order": ["A", "B"]}, few) == \
+        Verdict(Outcome.NOT_TESTABLE, "too few runs (4)")
+
+
+def test_identical_outcomes_are_no_difference_not_a_win():
+    both_fail = _records({"A": 0.0, "B": 0.0}, metric="tracked_to_end[cle<=20]", noise=0.0)
+    both_fail["tracked_to_end[cle<=20]"] = 0.0
+    verdict = _verdict({"test": "order", "metric": "tracked_to_end[cle<=20]", "order": ["A", "B"]}, both_fail)
+    assert verdict.outcome is Outcome.NOT_REPRODUCED and "no difference" in verdict.why
+
+
+def test_threshold_and_best():
+    records = _records({"A": 0.0, "B": 1.0}, metric="fps")
+    assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 2.0,
+                     "statistic": "median"}, records).outcome is Outcome.REPRODUCED
+    assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 50.0},
+                    records).outcome is Outcome.NOT_REPRODUCED
+    sequences = pd.DataFrame([{"method": m, "condition": f"scene={s}", "precision20": score}
+                              for s in range(6) for m, score in (("A", 0.9), ("B", 0.5 + 0.01 * s))])
+    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, sequences).outcome \
+        is Outcome.REPRODUCED
+    assert _verdict({"test": "best", "metric": "precision20", "method": "B"}, sequences).outcome \
+        is Outcome.NOT_REPRODUCED
+    split = sequences.assign(precision20=[0.9 if (s % 2 == 0) == (m == "A") else 0.5
+                                          for s, m in zip(sequences["condition"].str[-1].astype(int),
+                                                          sequences["method"])])
+    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, split).outcome \
+        is Outcome.INCONCLUSIVE
+    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, sequences.iloc[:8]).outcome \
+        is Outcome.NOT_TESTABLE  # four sequences
+
+
+def test_result_combines_checks():
+    def check(outcome):
+        return Check("x", Verdict(outcome), Estimate(1.0, 0.5, 1.5, 10, ""))
+
+    yes, no, maybe, untestable = (check(o) for o in (Outcome.REPRODUCED, Outcome.NOT_REPRODUCED,
+                                                     Outcome.INCONCLUSIVE, Outcome.NOT_TESTABLE))
+    assert Result.of([yes, yes, untestable]).verdict.outcome is Outcome.REPRODUCED
+    assert Result.of([yes, maybe]).verdict.outcome is Outcome.INCONCLUSIVE
+    assert Result.of([maybe, no, yes]).verdict.outcome is Outcome.NOT_REPRODUCED
+    assert Result.of([maybe, no]).deciding is not None
+    assert Result.of([untestable]).verdict.outcome is Outcome.NOT_TESTABLE
+    assert Result.of([]).verdict.outcome is Outcome.NOT_TESTABLE
