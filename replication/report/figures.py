@@ -1,5 +1,7 @@
 """Figures drawn from run records with matplotlib (Agg backend, PNG files)."""
 
+import re
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -8,60 +10,189 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from replication.report.aggregate import summarise  # noqa: E402
+from replication.report.published import cells, load_published  # noqa: E402
+from replication.report.style import (  # noqa: E402
+    BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+    shades,
+)
+
+PLAIN = FuncFormatter(lambda value, _: f"{value:g}")  # 0.1, 20, 500 rather than powers of ten
 
 
 def parse_condition(condition: str) -> dict[str, str]:
     return dict(part.split("=", 1) for part in condition.split(";") if part)
 
 
-def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
+                        published: pd.DataFrame | None = None) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
     ``by`` (a swept variable) splits the figure into one panel per value;
-    x is on a log scale unless ``log_x: false``;
-    ``fit_slope`` adds each series' log-log slope to its label.  A
+    x is on a log scale unless ``log_x: false``; ``xlabel`` overrides the
+    axis' words; ``fit_slope`` adds each series' log-log slope to its label.  A
     method that does not sweep ``x`` (the point-mass reference, say) is drawn
-    as a horizontal band.
+    as a horizontal band.  A method's series (one per value of another
+    parameter) are shades of its colour.  A run more than 10 times its cell's
+    median (or beyond ``clip``), or not finite, diverged: it counts at that
+    level and its series' label says how many did.  With ``paper_table`` (and
+    ``published``), the paper's values are hollow diamonds in the method's
+    colour (see :func:`paper_points`).
     """
-    methods = experiment["methods"]
-    summary = summarise(records, spec["metric"])
+    metric = spec["metric"]
+    summary = _summary(records, metric, spec)
+    summary = summary[summary["mean"].notna()]  # a metric the method does not have (the grid's ESS)
     conditions = summary["condition"].map(parse_condition)
     summary["x"] = conditions.map(lambda c: float(c.get(spec["x"], "nan")))
     summary["panel"] = conditions.map(lambda c: c.get(spec.get("by"), ""))
-    summary["series"] = [
-        " ".join([methods[m].get("label", m)] + [f"{k}={v}" for k, v in c.items() if k not in (spec["x"], spec.get("by"))])
-        for m, c in zip(summary["method"], conditions)
-    ]
+    summary["rest"] = conditions.map(lambda c: " ".join(f"{k}={v}" for k, v in c.items()
+                                                        if k not in (spec["x"], spec.get("by"))))
+    colours = _series_colours(summary)
+    paper = (paper_points(published, spec, experiment, set(summary["method"]))
+             if published is not None and "paper_table" in spec else None)
     reference = summary["x"].isna() & (summary["panel"] == "")  # e.g. the Bayes floor: drawn in every panel
     panels = list(dict.fromkeys(summary.loc[~reference, "panel"])) or [""]
     fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4), squeeze=False)
+    legend_rows = 0  # of the tallest legend
     for ax, panel in zip(axes[0], panels):
         rows = summary[(summary["panel"] == panel) | reference]
-        for series, group in rows[rows["x"].notna()].groupby("series", sort=False):
-            group = group.sort_values("x")
-            if spec.get("fit_slope") and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
-                slope = np.polyfit(np.log(group["x"]), np.log(group["mean"]), 1)[0]
-                series = f"{series} (slope {slope:.2f})"
-            ax.plot(group["x"], group["mean"], marker="o", label=series)
-            ax.fill_between(group["x"], group["ci_low"], group["ci_high"], alpha=0.2)
+        _series(ax, rows[rows["x"].notna()], colours, spec, experiment)
         for _, row in rows[rows["x"].isna()].iterrows():
-            line = ax.axhline(row["mean"], linestyle="--", color="k", label=row["series"])
-            ax.axhspan(row["ci_low"], row["ci_high"], color=line.get_color(), alpha=0.1)
-        if spec.get("log_x", True):
-            ax.set_xscale("log")
-        if spec.get("log_y"):
-            ax.set_yscale("log")
-        ax.set_xlabel(spec["x"])
-        ax.set_ylabel(f"{spec['metric']} (mean, 95% CI)")
-        ax.set_title(f"{spec.get('by')}={panel}" if panel else spec.get("title", ""), fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+            colour = colours[row["method"], row["rest"]]
+            label = f"{method_label(experiment, row['method'])} {row['rest']}".strip()
+            ax.axhline(row["mean"], linestyle="--", color=colour,
+                       label=label + clipped_note(row["diverged"], row["total"]))
+            ax.axhspan(row["ci_low"], row["ci_high"], color=colour, alpha=0.1)
+        if paper is not None:
+            for method, points in paper.groupby("method", sort=False):
+                ax.plot(points["x"], points["value"], **PAPER, markeredgecolor=method_look(method).colour,
+                        label="paper", zorder=3)
+        _axes(ax, spec, list(rows["x"].dropna()) + (list(paper["x"]) if paper is not None else []))
+        ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
+        title = f"{axis_label(spec['by'])}: {panel}" if panel else spec.get("title", "")
+        ax.set_title(textwrap.fill(title, 75), fontsize=9)
+        legend_rows = max(legend_rows, _legend(ax))
+    fig.set_figheight(4 + 0.17 * legend_rows)
+    return save(fig, path, dpi=120)
+
+
+def _series(ax, rows: pd.DataFrame, colours: dict, spec: dict, experiment: dict) -> None:
+    """One line per (method, other parameters), its 95% intervals as error bars; the lines are nudged
+    apart along x so that equal means do not hide each other."""
+    series = list(rows.groupby(["method", "rest"], sort=False))
+    for i, ((method, rest), group) in enumerate(series):
+        group = group.sort_values("x")
+        label = f"{method_label(experiment, method)} {rest}".strip()
+        if spec.get("fit_slope") and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
+            label += f" (slope {np.polyfit(np.log(group['x']), np.log(group['mean']), 1)[0]:.2f})"
+        label += clipped_note(group["diverged"].sum(), group["total"].sum())
+        x = _nudged(group["x"], i - (len(series) - 1) / 2, rows["x"], spec.get("log_x", True))
+        below, above = group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]
+        ax.errorbar(x, group["mean"], yerr=[below, above],
+                    **{**method_look(method).line(), "color": colours[method, rest]}, markersize=5, capsize=2,
+                    elinewidth=0.8, label=label)
+
+
+def _nudged(x: pd.Series, step: float, every_x: pd.Series, log: bool) -> pd.Series:
+    """``x`` moved by ``step`` times 1.2% of the x range (of its logarithm, on a log axis)."""
+    if log:
+        return x * (every_x.max() / every_x.min()) ** (0.012 * step)
+    return x + 0.012 * step * (every_x.max() - every_x.min())
+
+
+def _axes(ax, spec: dict, xs: list[float]) -> None:
+    """Scales, x label and grid; ticks at the values drawn when they are few (a sweep's), in plain numbers."""
+    ax.set_xscale("log" if spec.get("log_x", True) else "linear")
+    if spec.get("log_y"):
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(PLAIN)
+        ax.yaxis.set_minor_formatter(_minor_labels(*ax.get_ylim()))
+    values = sorted(set(xs))
+    if len(values) <= 12:
+        ax.set_xticks(values, [f"{v:g}" for v in values])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel(spec.get("xlabel") or axis_label(spec["x"]))
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def _summary(records: pd.DataFrame, metric: str, spec: dict) -> pd.DataFrame:
+    """:func:`summarise` of the clipped runs, with each cell's count of diverged runs and of all runs."""
+    values, diverged = _clipped(records, metric, spec)
+    records = records.assign(**{metric: values, "diverged": diverged})
+    runs = records.groupby(["method", "condition"], sort=False)["diverged"]
+    counts = runs.agg(diverged="sum", total="size")
+    return summarise(records, metric).merge(counts.reset_index(), on=["method", "condition"])
+
+
+def _clipped(records: pd.DataFrame, metric: str, spec: dict) -> tuple[pd.Series, pd.Series]:
+    """``metric`` per run, each (method, condition) cell's diverged runs clipped at 10 times the cell's
+    median (or ``spec.clip``); and which runs diverged.  A cell with no finite value (a metric the
+    method does not have) is left as it is."""
+    values = records[metric].astype(float)
+    clipped, diverged = values.copy(), pd.Series(False, index=records.index)
+    for index in records.groupby(["method", "condition"], sort=False).groups.values():
+        cell = values[index]
+        if np.isfinite(cell).any():
+            clipped[index], diverged[index] = clip_diverged(cell, clip_level(spec, cell.median()))
+    return clipped, diverged
+
+
+def _series_colours(summary: pd.DataFrame) -> dict[tuple[str, str], tuple]:
+    """(method, other parameters) -> colour: the method's own, in shades (dark to light, in the
+    parameters' natural order) where it has several series."""
+    colours = {}
+    for method, group in summary.groupby("method", sort=False):
+        rests = sorted(set(group["rest"]), key=_natural)
+        colours.update(zip([(method, r) for r in rests], shades(method_look(method).colour, len(rests))))
+    return colours
+
+
+def _natural(text: str) -> list[tuple]:
+    """Sort key reading the numbers in ``text`` as numbers: hms=2 before hms=10."""
+    return [(0, float(part), "") if re.fullmatch(r"\d+\.?\d*", part) else (1, 0.0, part)
+            for part in re.split(r"(\d+\.?\d*)", text)]
+
+
+def paper_points(published: pd.DataFrame, spec: dict, experiment: dict, methods: set[str]) -> pd.DataFrame:
+    """The published values a figure rebuilds, as (method, x, value): the cells of ``spec.paper_table``
+    and ``spec.paper_metric`` (default: ``metric``) for the figure's methods, at the x their condition
+    gives (``N=500``) or, where it gives none, at ``spec.paper_x[<the cell's experiment>]``;
+    ``paper_scale`` puts the paper's unit on ours (0.01: a percentage on a share)."""
+    metric = spec.get("paper_metric", spec["metric"])
+    chosen = cells(published, experiment["paper"], spec["paper_table"], metric)
+    chosen = chosen[chosen["method"].isin(methods) & chosen["number"].notna()]
+    at = spec.get("paper_x", {})
+    x = [parse_condition(condition).get(spec["x"], at.get(scene))
+         for condition, scene in zip(chosen["condition"], chosen["experiment"])]
+    points = pd.DataFrame({"method": chosen["method"], "x": pd.to_numeric(pd.Series(x, index=chosen.index)),
+                           "value": chosen["number"] * spec.get("paper_scale", 1)})
+    return points.dropna()
+
+
+def _minor_labels(low: float, high: float) -> FuncFormatter:
+    """Which minor ticks of a log axis get a label: all within a factor 3, 2, 3 and 5 within a decade,
+    none beyond (the powers of ten suffice)."""
+    digits = set(range(2, 10)) if high < 3 * low else {2, 3, 5} if high < 10 * low else set()
+
+    def label(value, _):
+        return f"{value:g}" if round(value / 10 ** np.floor(np.log10(value))) in digits else ""
+
+    return FuncFormatter(label)
+
+
+def _legend(ax) -> int:
+    """The axes' legend below them, in two columns, the paper's values once (a hollow black diamond);
+    return its number of rows."""
+    entries = dict(zip(*ax.get_legend_handles_labels()[::-1]))
+    if entries.pop("paper", None):  # once, last
+        entries["paper"] = Line2D([], [], **PAPER, markeredgecolor=BLACK)
+    if entries:
+        ax.legend(entries.values(), entries.keys(), fontsize=7, ncol=2, frameon=False, loc="upper center",
+                  bbox_to_anchor=(0.5, -0.16))
+    return (len(entries) + 1) // 2
 
 
 def _figures():
@@ -79,9 +210,20 @@ def _figures():
     }
 
 
-def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``."""
+def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
+         published: pd.DataFrame | None = None) -> Path:
+    """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
+
+    A spec that names a ``paper_table`` gets the published values: ``published``,
+    else those of ``conf/config.yaml``'s ``published_values`` (none if that file is missing).
+    """
     figures = _figures()
     if spec["kind"] not in figures:
         raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(figures)}")
-    return figures[spec["kind"]](records, spec, experiment, path)
+    if "paper_table" not in spec:
+        return figures[spec["kind"]](records, spec, experiment, path)
+    if published is None:
+        from replication.report.index import default_published_values
+
+        published = load_published(str(default_published_values()))
+    return figures[spec["kind"]](records, spec, experiment, path, published=published)

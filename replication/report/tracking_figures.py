@@ -6,7 +6,11 @@ import cv2
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.colors import to_rgb
 
+from replication.report.style import (
+    axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+)
 from replication.scenes.factory import cached_sequence
 
 
@@ -14,35 +18,52 @@ def _by_condition(records: pd.DataFrame):
     return list(records.groupby("condition", sort=False))
 
 
-def _label(experiment: dict, method: str) -> str:
-    return experiment["methods"][method].get("label", method)
-
-
 def per_frame_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition;
-    methods that do not record the series are left out."""
+    methods that do not record the series are left out.
+
+    A run diverged where it is not finite or beyond ``spec.clip`` (by default 10
+    times the largest median over runs of any method at any frame, in size: a
+    method that loses the target stays as it is, one run blown far beyond
+    what any method typically does is not): it is clipped there, so that it
+    does not flatten every other curve, and the method's label says how many
+    runs did.
+    """
     groups = _by_condition(records)
     fig, axes = plt.subplots(len(groups), 1, figsize=(7, 2.6 * len(groups)), squeeze=False)
     for ax, (condition, group) in zip(axes[:, 0], groups):
-        for method, runs in group.groupby("method", sort=False):
-            if spec["series"] not in runs["per_frame"].iloc[0]:  # e.g. alpha_k: fusion filters only
-                continue
-            series = np.array([r[spec["series"]] for r in runs["per_frame"]], dtype=float)
-            frames = np.arange(1, series.shape[1] + 1)
-            kept = ~np.isnan(series).all(axis=0)  # e.g. frame 1, given rather than estimated
-            series, frames = series[:, kept], frames[kept]
-            ax.plot(frames, np.nanmean(series, axis=0), label=_label(experiment, method))
-            low, high = np.nanpercentile(series, [10, 90], axis=0)
-            ax.fill_between(frames, low, high, alpha=0.2)
+        curves = _per_frame(group, spec["series"])
+        typical = max((np.nanmax(np.nanmedian(np.abs(v), axis=0)) for _, v in curves.values()),
+                      default=np.nan)
+        level = clip_level(spec, typical)
+        for method, (frames, values) in curves.items():
+            values, diverged = clip_diverged(values, level)
+            look = method_look(method)
+            ax.plot(frames, np.nanmean(values, axis=0), **look.line(), markevery=max(1, len(frames) // 12),
+                    markersize=4, lw=1.2,
+                    label=method_label(experiment, method) + clipped_note(diverged.sum(), len(diverged)))
+            low, high = np.nanpercentile(values, [10, 90], axis=0)
+            ax.fill_between(frames, low, high, color=look.colour, alpha=0.15)
         ax.set_title(condition, fontsize=9)
-        ax.set_ylabel(spec.get("ylabel", spec["series"]))
+        ax.set_ylabel(spec.get("ylabel") or axis_label(spec["series"]))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     axes[-1, 0].set_xlabel("frame")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)
+
+
+def _per_frame(group: pd.DataFrame, series: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each method's frames (1-based) and runs x frames values of a per-frame series, without the frames
+    no run estimates (the given first one); methods that do not record it (alpha_k: fusion filters
+    only) are left out."""
+    curves = {}
+    for method, runs in group.groupby("method", sort=False):
+        if series not in runs["per_frame"].iloc[0]:
+            continue
+        values = np.array([r[series] for r in runs["per_frame"]], dtype=float)
+        kept = ~np.isnan(values).all(axis=0)
+        curves[method] = (np.arange(1, values.shape[1] + 1)[kept], values[:, kept])
+    return curves
 
 
 def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
@@ -68,22 +89,22 @@ def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Pa
         sequence, chosen = _sequence(experiment, group)
         truth = sequence.truth[:, chosen]
         centre = truth[..., :2] + truth[..., 2:] / 2
+        frames = np.arange(1, len(centre) + 1)
         for axis, ax in enumerate(row):
-            ax.plot(centre[..., axis], "k-", lw=2, label="truth")
-            for index, (_, run) in enumerate(_first_runs(group).iterrows()):
+            ax.plot(frames, centre[..., axis], color="k", lw=2, alpha=0.35)[0].set_label("truth")
+            for _, run in _first_runs(group).iterrows():
                 boxes = np.array(run["per_frame"]["box"])
-                lines = ax.plot(boxes[..., axis] + boxes[..., axis + 2] / 2, color=f"C{index}", lw=1)
-                lines[0].set_label(_label(experiment, run["method"]))
+                look = method_look(run["method"])
+                lines = ax.plot(frames, boxes[..., axis] + boxes[..., axis + 2] / 2, color=look.colour,
+                                linestyle=look.linestyle, lw=1)
+                lines[0].set_label(method_label(experiment, run["method"]))
             ax.set_title(f"{condition}: centre {'xy'[axis]}", fontsize=9)
+            ax.set_ylabel(f"{'xy'[axis]} (px)")
             ax.grid(True, alpha=0.3)
         row[0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
-
-
-COLOURS = [(0, 0, 255), (255, 0, 0), (0, 200, 255), (255, 0, 255), (255, 255, 0)]
+    for ax in axes[-1]:
+        ax.set_xlabel("frame")
+    return save(fig, path)
 
 
 def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
@@ -93,7 +114,8 @@ def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
 
 
 def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """Snapshot grids, one block per condition; truth green, each method's first run in its colour.
+    """Snapshot grids, one block per condition; truth white edged in black, each method's first run in
+    its colour.
 
     ``rows: frames`` puts frames down and methods across (the papers' layout);
     otherwise methods down and frames across.
@@ -103,9 +125,9 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
         sequence, chosen = _sequence(experiment, group)
         frames = _frames(spec, _scene_name(experiment, condition), sequence.n_frames)
         runs = list(_first_runs(group).iterrows())
-        grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k, i) for i, (_, run) in enumerate(runs)]
-                for k in frames]
-        labels = [_label(experiment, run["method"]) for _, run in runs]
+        grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k,
+                           method_look(run["method"]).colour) for _, run in runs] for k in frames]
+        labels = [method_label(experiment, run["method"]) for _, run in runs]
         if spec.get("rows") != "frames":
             grid = [list(column) for column in zip(*grid)]
         blocks.append((condition, frames, labels, grid))
@@ -126,18 +148,19 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
                 ax.set_title(f"{condition}: {title}" if r == 0 else "", fontsize=6)
                 ax.text(-0.02, 0.5, side, transform=ax.transAxes, fontsize=6, rotation=90, ha="right", va="center")
         row += len(grid)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)
 
 
-def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, index: int) -> np.ndarray:
+def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, colour: str) -> np.ndarray:
+    """Frame ``k`` with each target's true box (white, edged in black outside) and estimated box
+    (``colour``)."""
     image = sequence.frame(k).copy()
+    estimate = tuple(int(255 * c) for c in to_rgb(colour)[::-1])  # BGR, as OpenCV draws
     for m, target in enumerate(chosen):
-        for box, colour in ((sequence.truth[k, target], (0, 200, 0)), (boxes[k, m], COLOURS[index % len(COLOURS)])):
-            x, y, w, h = box
-            cv2.rectangle(image, (int(x), int(y)), (int(x + w), int(y + h)), colour, 1)
+        x, y, w, h = sequence.truth[k, target]
+        cv2.rectangle(image, (int(x) - 1, int(y) - 1), (int(x + w) + 1, int(y + h) + 1), (0, 0, 0), 1)
+        for (x, y, w, h), bgr in ((sequence.truth[k, target], (255, 255, 255)), (boxes[k, m], estimate)):
+            cv2.rectangle(image, (int(x), int(y)), (int(x + w), int(y + h)), bgr, 1)
     return image
 
 
@@ -161,14 +184,12 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         first, last = spec.get("window", (None, None))
         if first is not None:
             ax.axvspan(first, last, color="w", alpha=0.08)
-        ax.set_title(f"{_label(experiment, run['method'])}: target {run['strip']['target'] + 1}", fontsize=9)
+        target = run["strip"]["target"] + 1
+        ax.set_title(f"{method_label(experiment, run['method'])}: target {target}", fontsize=9)
         ax.set_ylabel(f"{run['strip']['axis']} (px)")
         ax.legend(fontsize=6, loc="upper left")
     axes[-1, 0].set_xlabel("frame")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)
 
 
 def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
@@ -186,15 +207,14 @@ def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         overlaps = [np.asarray(r["iou"][1:], dtype=float) for r in runs["per_frame"]]
         precision = np.mean([tm.precision_curve(e) for e in errors], axis=0)
         success = np.mean([tm.success_curve(o) for o in overlaps], axis=0)
-        label = _label(experiment, method)
-        left.plot(tm.PRECISION_THRESHOLDS, precision, label=f"{label} [{np.mean([tm.precision_at(e) for e in errors]):.3f}]")
-        right.plot(tm.SUCCESS_THRESHOLDS, success, label=f"{label} [{np.mean([tm.success_auc(o) for o in overlaps]):.3f}]")
+        label, line = method_label(experiment, method), method_look(method).line()
+        left.plot(tm.PRECISION_THRESHOLDS, precision, **line, markevery=5, markersize=4,
+                  label=f"{label} [{np.mean([tm.precision_at(e) for e in errors]):.3f}]")
+        right.plot(tm.SUCCESS_THRESHOLDS, success, **line, markevery=3, markersize=4,
+                   label=f"{label} [{np.mean([tm.success_auc(o) for o in overlaps]):.3f}]")
     left.set(xlabel="location error threshold (px)", ylabel="precision", title="Precision plot (OPE)")
     right.set(xlabel="overlap threshold", ylabel="success rate", title="Success plot (OPE)")
     for ax in (left, right):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)

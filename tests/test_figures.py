@@ -1,0 +1,191 @@
+"""Figures a reader can compare: one look per method, the paper's values, diverged runs clipped; the PDF's
+page numbers and outline."""
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from matplotlib.colors import to_hex
+
+from replication.paths import CONF_DIR, resolve
+from replication.report import figures, tracking_figures
+from replication.report.published import load_published
+from replication.report.style import (
+    METHODS, PALETTE, axis_label, clip_diverged, method_look,
+)
+
+PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
+    "qmc,1,ungm,PF,rmse,N=100,9.2,,",
+    "qmc,1,ungm,PF,rmse,N=500,4.2,,",
+    "qmc,1,ungm,QPF,rmse,N=100,2.0,,",  # a method the figure does not draw
+    "qmc,1,ungm,PF,time,N=100,5.2,ms,",  # another metric
+    "qmc,2,ungm,NQMCPF,rmse,,3.3,,N not stated",  # placed by paper_x
+])
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures drawn, as matplotlib Figures (instead of PNG files)."""
+    kept = []
+
+    def keep(fig, path, dpi=110):
+        kept.append(fig)
+        return path
+
+    monkeypatch.setattr(figures, "save", keep)
+    monkeypatch.setattr(tracking_figures, "save", keep)
+    return kept
+
+
+def _scalar_records(values: dict[tuple[str, str], list[float]]) -> pd.DataFrame:
+    return pd.DataFrame([{"method": m, "condition": c, "repetition": r, "rmse": v}
+                         for (m, c), runs in values.items() for r, v in enumerate(runs)])
+
+
+def _tracking_records(curves: dict[str, list[list[float]]]) -> pd.DataFrame:
+    return pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": r, "per_frame": {"cle": [None, *run]}}
+                         for m, runs in curves.items() for r, run in enumerate(runs)])
+
+
+def _lines(fig, label: str) -> list:
+    """The drawn lines whose legend label starts with ``label`` (an error-bar series by its data line)."""
+    lines = [(line.get_label(), line) for ax in fig.axes for line in ax.get_lines()]
+    lines += [(c.get_label(), c.lines[0]) for ax in fig.axes for c in ax.containers]
+    return [line for name, line in lines if name.startswith(label)]
+
+
+def _label(fig, label: str) -> str:
+    return next(t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts() if t.get_text().startswith(label))
+
+
+def test_every_method_of_the_configs_has_a_look_of_its_own():
+    looks = list(METHODS.values())
+    assert len(set(looks)) == len(looks)
+    assert {look.colour for look in looks} <= set(PALETTE)
+    configured = {m for path in (CONF_DIR / "experiment").glob("*.yaml")
+                  for m in (yaml.safe_load(path.read_text()).get("methods") or {})}
+    assert configured <= set(METHODS), sorted(configured - set(METHODS))
+    own = method_look("my-filter")  # a user's own method: stable, and unlike every known one
+    assert own == method_look("my-filter") and own not in looks and own.colour in PALETTE
+
+
+def test_a_method_looks_the_same_on_figures_of_two_experiments(drawn, tmp_path):
+    ungm = {"paper": "qmc", "methods": {"PF": {"label": "PF (bootstrap)"}, "grid": {}}}
+    tracking = {"paper": "trk", "methods": {"ISM-PF": {}, "PF": {"label": "PF"}}}
+    rng = np.random.default_rng(0)
+    figures.draw(_scalar_records({("PF", f"N={n}"): list(rng.uniform(4, 5, 5)) for n in (100, 500)}
+                                 | {("grid", ""): [4.0, 4.1]}),
+                 {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, ungm, tmp_path / "a.png")
+    figures.draw(_tracking_records({"ISM-PF": rng.uniform(0, 5, (4, 30)).tolist(),
+                                    "PF": rng.uniform(0, 5, (4, 30)).tolist()}),
+                 {"kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png")
+    pf = [_lines(fig, "PF")[0] for fig in drawn]
+    assert {to_hex(line.get_color()) for line in pf} == {method_look("PF").colour.lower()}
+    assert {line.get_marker() for line in pf} == {method_look("PF").marker}
+    assert to_hex(_lines(drawn[1], "ISM-PF")[0].get_color()) == method_look("ISM-PF").colour.lower()
+    assert to_hex(_lines(drawn[0], "grid")[0].get_color()) == method_look("grid").colour
+    assert drawn[0].axes[0].get_xlabel() == "number of particles N"
+    assert drawn[1].axes[0].get_ylabel() == "centre location error (px)"
+
+
+def test_axis_labels_read_in_words_with_the_raw_name_as_fallback():
+    assert axis_label("ms_per_step") == "time per step (ms)"
+    assert axis_label("correct_frames[iou>=0.5]") == "share of frames with IoU ≥ 0.5"
+    assert axis_label("my_metric") == "my_metric" and axis_label("my_metric[x>1]") == "my_metric[x>1]"
+
+
+def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_path):
+    csv = tmp_path / "published.csv"
+    csv.write_text(PUBLISHED)
+    experiment = {"paper": "qmc", "methods": {"PF": {}, "NQMCPF": {}}}
+    records = _scalar_records({(m, f"N={n}"): [4.0, 4.5, 5.0] for m in ("PF", "NQMCPF") for n in (100, 200, 500)})
+    spec = {"kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
+            "paper_x": {"ungm": 200}}
+    figures.draw(records, spec, experiment, tmp_path / "f.png", published=load_published(str(csv)))
+    paper = {to_hex(line.get_markeredgecolor()): (list(line.get_xdata()), list(line.get_ydata()))
+             for line in _lines(drawn[0], "paper")}
+    assert paper == {method_look("PF").colour.lower(): ([100, 500], [9.2, 4.2]),
+                     method_look("NQMCPF").colour.lower(): ([200], [3.3])}
+    assert all(line.get_marker() == "D" and line.get_markerfacecolor() == "none" for line in _lines(drawn[0], "paper"))
+    legend = [t.get_text() for t in drawn[0].axes[0].get_legend().get_texts()]
+    assert legend.count("paper") == 1
+    figures.draw(records, {k: v for k, v in spec.items() if k != "paper_table"}, experiment, tmp_path / "g.png",
+                 published=load_published(str(csv)))
+    assert not _lines(drawn[1], "paper")  # no paper_table: no diamonds
+
+
+def test_the_configs_paper_table_puts_table_1_on_the_rmse_figure(drawn, tmp_path):
+    published = resolve("../shared/reference/published_values.csv")
+    if not published.exists():
+        pytest.skip("../shared is not beside the project")
+    config = yaml.safe_load((CONF_DIR / "experiment" / "gps_qmcpf.yaml").read_text())
+    spec = next(s for s in config["report"]["figures"] if s["name"] == "rmse_vs_n")
+    records = _scalar_records({(m, f"N={n}"): [4.0, 4.5] for m in config["methods"] if m != "grid"
+                               for n in (100, 200, 500)})
+    figures.draw(records, spec, config, tmp_path / "rmse.png", published=load_published(str(published)))
+    points = sorted((x, y) for line in _lines(drawn[0], "paper") for x, y in zip(line.get_xdata(), line.get_ydata()))
+    assert len(points) == 12 and (500, 1.597) in points  # Table 1: four methods at N = 100, 200, 500
+
+
+def test_clip_diverged_puts_non_finite_and_huge_values_at_the_level():
+    values, diverged = clip_diverged([[1.0, 2.0], [np.inf, 1.0], [-50.0, 1.0], [1.0, np.nan]], level=10.0)
+    assert values.tolist() == [[1.0, 2.0], [10.0, 1.0], [-10.0, 1.0], [1.0, 10.0]]
+    assert diverged.tolist() == [False, True, True, True]
+    values, diverged = clip_diverged([1.0, np.inf], level=None)  # no level: left out, still counted
+    assert np.isnan(values[1]) and diverged.tolist() == [False, True]
+
+
+def test_diverged_runs_are_clipped_and_counted_on_per_frame_curves(drawn, tmp_path):
+    rng = np.random.default_rng(1)
+    good = rng.uniform(1, 3, (10, 40))
+    good[2, 20:] = 1e6  # blown up
+    good[5, 7] = np.inf
+    lost = rng.uniform(80, 120, (5, 40))  # a method that loses the target every run: not a divergence
+    experiment = {"methods": {"PF": {"label": "PF"}, "MIL": {"label": "MIL"}}}
+    figures.draw(_tracking_records({"PF": good.tolist(), "MIL": lost.tolist()}),
+                 {"kind": "per_frame_curve", "series": "cle"}, experiment, tmp_path / "c.png")
+    pf, mil = _lines(drawn[0], "PF")[0], _lines(drawn[0], "MIL")[0]
+    assert _label(drawn[0], "PF") == "PF (2 of 10 runs diverged, clipped)" and _label(drawn[0], "MIL") == "MIL"
+    assert max(pf.get_ydata()) < max(mil.get_ydata()) * 10 / 2  # the blown-up run no longer dominates
+
+
+def test_diverged_runs_are_clipped_and_counted_on_metric_curves(drawn, tmp_path):
+    experiment = {"methods": {"PF": {"label": "PF"}}}
+    records = _scalar_records({("PF", "N=100"): [4.0, 5.0, 1e9, 4.5, 5.5], ("PF", "N=500"): [3.0, np.inf, 3.2, 3.1]})
+    figures.draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, experiment,
+                 tmp_path / "m.png")
+    line = _lines(drawn[0], "PF")[0]
+    assert _label(drawn[0], "PF") == "PF (2 of 9 runs diverged, clipped)"
+    assert line.get_ydata()[0] < 10 * 5.0  # the mean with the 1e9 run counted at 10 times the median
+    assert np.isfinite(np.asarray(line.get_ydata(), dtype=float)).all()
+
+
+def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
+    import matplotlib.pyplot as plt
+    import pypdf
+
+    from replication.report import pdf
+
+    png = tmp_path / "f.png"
+    fig = plt.figure(figsize=(4, 3))
+    fig.savefig(png)
+    plt.close(fig)
+    path = tmp_path / "book.pdf"
+    long = pd.DataFrame({"method": [f"method {i}" for i in range(150)], "value": range(150)})
+    with pdf._Book(path) as book:
+        pdf._table_pages(book, "Experiment A", long, subtitle="Table 1: a long one", font=pdf.TABLE_FONT)
+        pdf._figure_page(book, "Experiment A", "Figure 1", png)
+        pdf._figure_page(book, "Experiment B", "Figure 2", png)
+    pdf._outline(path, book.marks)
+    reader = pypdf.PdfReader(str(path))
+    n = len(reader.pages)
+    assert n >= 4  # the table takes at least two pages
+    for k, page in enumerate(reader.pages, start=1):
+        assert f"page {k}" in page.extract_text()
+    outline = reader.outline
+    sections = [item for item in outline if not isinstance(item, list)]
+    assert [s.title for s in sections] == ["Experiment A", "Experiment B"]
+    entries = [[(e.title, reader.get_destination_page_number(e)) for e in item] for item in outline
+               if isinstance(item, list)]
+    assert entries == [[("Table 1: a long one", 0), ("Figure 1", n - 2)], [("Figure 2", n - 1)]]
+    assert reader.get_destination_page_number(sections[1]) == n - 1
