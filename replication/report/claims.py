@@ -293,7 +293,7 @@ def _judge_sign(difference: Estimate, lower_is_better: bool, allowed: float) -> 
 
 
 def load_papers(directory: Path = CLAIMS_DIR) -> list[Paper]:
-    """Every paper's claims, in file-name order."""
+    """Every paper's claims, in the order the papers are numbered (``order:`` in each file)."""
     papers = []
     for path in sorted(Path(directory).glob("*.yaml")):
         data = yaml.safe_load(path.read_text())
@@ -305,8 +305,8 @@ def load_papers(directory: Path = CLAIMS_DIR) -> list[Paper]:
                   note=c.get("note", ""))
             for c in data["claims"]
         )
-        papers.append(Paper(data["paper"], data["title"], data["authors"], data["venue"], claims))
-    return papers
+        papers.append((data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)))
+    return [paper for _, paper in sorted(papers, key=lambda item: item[0])]
 
 
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table]) -> dict:

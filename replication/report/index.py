@@ -17,7 +17,7 @@ from replication.report.claims import load_papers
 from replication.report.published import load_published
 from replication.report.render import render
 from replication.report.scale import scale_note
-from replication.report.scorecard import claim_rows, claims_frame, owner_of_cells, tally
+from replication.report.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table
 from replication.report.verdict import RULES
 
@@ -57,7 +57,8 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
-    claims_frame(rows, published, papers).to_csv(reports / "claims.csv", index=False)
+    tallies = cell_tallies(cells)
+    claims_frame(rows, published, papers, tallies).to_csv(reports / "claims.csv", index=False)
     page = reports / "index.html"
     page.write_text(
         render(
@@ -69,6 +70,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             papers=[{"paper": paper, "claims": rows[paper.key], "tally": tally(rows[paper.key]),
                      "cells": int((cells["paper"] == paper.key).sum())} for paper in papers],
             scale_note=_scale_note(summaries),
+            tallies=tallies,
             rules=RULES,
             counts=counts(cells),
             benchmark=(reports / "benchmark" / "index.html").exists(),

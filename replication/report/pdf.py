@@ -34,7 +34,7 @@ from replication.report.index import TITLE, default_published_values  # noqa: E4
 from replication.report.published import load_published  # noqa: E402
 from replication.report.claims import load_papers  # noqa: E402
 from replication.report.scale import scale_note  # noqa: E402
-from replication.report.scorecard import claim_rows, owner_of_cells, tally  # noqa: E402
+from replication.report.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.report.tables import Table  # noqa: E402
 from replication.report.verdict import RULES  # noqa: E402

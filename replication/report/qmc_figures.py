@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from replication.qmc import discrepancy, discrepancy_table, point_set
+from replication.qmc import discrepancy, point_set
 
 PANELS = (("random", "random (uniform)"), ("halton", "Halton"), ("good_cos", "good point set, r = 2cos(2 pi i / p)"),
           ("good_exp", "good point set, r = exp(i)"))
@@ -27,9 +27,3 @@ def point_sets(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
-
-
-def discrepancies(spec: dict) -> pd.DataFrame:
-    """The discrepancy table beside Figures 1-3 (random: mean over seeds)."""
-    return discrepancy_table(n=int(spec.get("n", 400)), dims=tuple(spec.get("dims", (2, 3, 5))),
-                             method=spec.get("method", "CD"))

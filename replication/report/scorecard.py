@@ -40,6 +40,11 @@ class ClaimRow:
         return self.primary.verdict
 
     @property
+    def evidence(self) -> list[tuple[str, str]]:
+        """The experiments its readings were tested on, each once, with the scale their runs are at."""
+        return list(dict.fromkeys((r.reading.experiment, r.scale) for r in self.results if r.scale))
+
+    @property
     def robustness(self) -> str:
         """Whether the verdict is the same under every reading, or which reading it hinges on."""
         judged = [r for r in self.results if r.verdict.outcome is not Outcome.NOT_TESTABLE]
@@ -85,7 +90,24 @@ def owner_of_cells(papers: list[Paper], published: pd.DataFrame) -> list[str]:
     return [next((c.id for c in claims if c.owns(cell)), "") for _, cell in published.iterrows()]
 
 
-def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, papers: list[Paper]) -> pd.DataFrame:
+def cell_tallies(cells: pd.DataFrame) -> dict[str, str]:
+    """Per claim, what became of the published cells it owns: '12 cells: 3 reproduced, 9 not reproduced
+    (8 below the Bayes floor); 2 not compared' (``cells``: the summary of every cell, with its claim)."""
+    tallies = {}
+    for claim, owned in cells[cells["claim"] != ""].groupby("claim", sort=False):
+        compared = owned[owned["outcome"] != ""]
+        parts = [f"{n} {outcome}" for outcome, n in compared["outcome"].value_counts().items()]
+        floor = int(compared["verdict"].str.contains("below the Bayes floor").sum())
+        if floor:
+            parts.append(f"{floor} below the Bayes floor")
+        if len(owned) > len(compared):
+            parts.append(f"{len(owned) - len(compared)} not compared")
+        tallies[claim] = f"{len(owned)} cells: " + ", ".join(parts)
+    return tallies
+
+
+def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, papers: list[Paper],
+                 tallies: dict[str, str]) -> pd.DataFrame:
     """``reports/claims.csv``: one row per claim with its verdict, deciding number and interval, runs,
     why, robustness across readings, and the published cells it owns."""
     owners = owner_of_cells(papers, published)
@@ -101,5 +123,6 @@ def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, paper
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
                 "scale": row.primary.scale,
                 "cells": sum(owner == row.claim.id for owner in owners),
+                "cell_verdicts": tallies.get(row.claim.id, ""), "note": row.claim.note,
             })
     return pd.DataFrame(table)
