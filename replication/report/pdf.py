@@ -33,7 +33,7 @@ from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
 from replication.report.index import TITLE, default_published_values  # noqa: E402
 from replication.report.published import load_published  # noqa: E402
 from replication.report.claims import load_papers  # noqa: E402
-from replication.report.scale import scale_note  # noqa: E402
+from replication.report.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.report.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.report.tables import Table  # noqa: E402
@@ -63,11 +63,15 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     cells = summary_table(published, summaries, configs, owner_of_cells(papers, published))
     path = reports / "replication.pdf"
     reports.mkdir(parents=True, exist_ok=True)
-    with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path) as pdf:
+    quick = [name for name, s in summaries.items() if s.get("scale") != "paper"]
+    banner = (f"Quick scale ({len(quick)} of {len(summaries)} experiments): fewer runs and shorter scenes than "
+              f"the papers'. Paper scale: {PAPER_COMMAND}." if quick else None)
+    tallies = cell_tallies(cells)
+    with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path, banner) as pdf:
         _title_page(pdf, summaries, cells, rows)
         for paper in papers:
             counted = ", ".join(f"{n} {outcome}" for outcome, n in tally(rows[paper.key]).items())
-            _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key]),
+            _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key], tallies),
                          widths=SCORECARD_COLUMNS,
                          subtitle=f"{paper.authors}; {paper.venue} ({paper.key}). Claims: {counted}.")
         _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": [RULES]}), widths={"rules": 200})
@@ -138,13 +142,13 @@ def _summary_frame(cells: pd.DataFrame) -> pd.DataFrame:
     })
 
 
-def _scorecard_frame(rows) -> pd.DataFrame:
+def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     """One paper's claims as the scorecard prints them."""
     return pd.DataFrame({
         "claim": [f"{r.claim.text} ({r.claim.source})" for r in rows],
         "verdict": [r.verdict.outcome.value for r in rows],
         "deciding number (95% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
-        "why": [r.verdict.why for r in rows],
+        "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
         "readings": [r.primary.reading.name + ("" if len(r.results) == 1 else f"; {r.robustness}") for r in rows],
     })
 
@@ -350,15 +354,19 @@ class _Book(PdfPages):
     """PdfPages that numbers its pages and remembers each page's place in the outline (its heading and
     subtitle, as :func:`_header` gave them)."""
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, banner: str | None = None):
         super().__init__(path)
         self.marks = []  # (heading, subtitle, page index)
+        self.banner = banner  # printed at the foot of every page (the quick scale's warning)
 
     def savefig(self, figure, **kwargs):
         page = self.get_pagecount()
         if hasattr(figure, "outline"):
             self.marks.append((*figure.outline, page))
         figure.text(0.985, 0.012, f"page {page + 1}", ha="right", va="bottom", fontsize=8, color="#555555")
+        if self.banner:
+            figure.text(0.035, 0.012, self.banner, ha="left", va="bottom", fontsize=7, color="#8a5a00",
+                        parse_math=False)
         super().savefig(figure, **kwargs)
 
 
