@@ -122,3 +122,18 @@ def test_result_combines_checks():
     assert Result.of([maybe, no]).deciding is not None
     assert Result.of([untestable]).verdict.outcome is Outcome.NOT_TESTABLE
     assert Result.of([]).verdict.outcome is Outcome.NOT_TESTABLE
+
+
+def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
+    from replication.report.tables import Rating
+
+    published = pd.DataFrame({"paper": ["p"], "table": ["3"], "experiment": ["s"], "method": ["A"],
+                              "metric": ["stability"], "condition": [""], "value": ["good"], "unit": [""],
+                              "note": [""], "number": [np.nan]})
+    records = pd.DataFrame({"method": "A", "condition": "scene=s", "failed": [0.0] * 28 + [1.0] * 12})
+    spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability",
+            "match": {"scene=s": {"experiment": "s"}}}
+    table = Rating(spec, {"paper": "p", "methods": {"A": {}}}, published).build(records)
+    result = Result.of(ClaimTest.of({"test": "cells", "tables": ["t3"]}, EXPERIMENT).checks(records, {"t3": table}))
+    assert result.verdict.outcome is Outcome.NOT_REPRODUCED  # 12 of 40 failed: [0.18, 0.45], medium, not good
+    assert result.deciding.estimate.value == 0.3 and "(ours: medium)" in result.deciding.what

@@ -191,11 +191,13 @@ class Cells(ClaimTest):
             table = tables.get(name)
             for entry in [] if table is None else table.cells:
                 estimate = None
-                if entry.get("ci_low") is not None:
-                    estimate = Estimate(entry["ours"], entry["ci_low"], entry["ci_high"], entry["runs"], "")
+                if entry.get("value") is not None:
+                    estimate = Estimate(entry["value"], entry["ci_low"] if entry["ci_low"] is not None else math.nan,
+                                        entry["ci_high"] if entry["ci_high"] is not None else math.nan,
+                                        entry["runs"], entry.get("interval", ""))
                 what = f"{entry['method']} {entry['experiment']} {entry['condition']}".strip()
                 verdict = Verdict.from_dict(entry["verdict"]) if entry["verdict"] else Verdict(Outcome.NOT_TESTABLE)
-                if estimate is None and isinstance(entry["ours"], str):
+                if isinstance(entry["ours"], str):  # a rating: the proportion of runs behind it is the number
                     what = f"{what} (ours: {entry['ours']})"
                 found.append(Check(what, verdict, estimate))
         return found

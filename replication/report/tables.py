@@ -135,6 +135,7 @@ class TableKind:
             "our_condition": "" if row["condition"] == "-" else row["condition"],
             "runs": int(row["runs"]),
             "ours": ours if ours is not None else _number(estimate.value),
+            "value": _number(estimate.value) if estimate else None,  # a rating's too: the proportion behind it
             "ci_low": _number(estimate.low) if estimate else None,
             "ci_high": _number(estimate.high) if estimate else None,
             "interval": estimate.method if estimate else "",
