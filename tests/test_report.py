@@ -201,3 +201,15 @@ def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
     assert two_mode_share(density, hypotheses, 100.0, width=5.0, mass=0.1) == pytest.approx(1 / 3)
     with pytest.raises(ValueError, match="never separate"):
         two_mode_share(density[3:], hypotheses[3:], 100.0, width=5.0, mass=0.1)
+
+
+def test_scale_changes_lists_what_quick_changes_from_the_config():
+    from replication.report.scale import scale_changes, scale_note
+
+    config = {"quick_frames": {"paper": None, "quick": 100},  # a YAML anchor, not a setting
+              "runs": {"paper": 100, "quick": 10},
+              "scenes": {"Girl": {"last": {"paper": None, "quick": 100}}, "b": {"frames": {"paper": 5, "quick": 5}}},
+              "methods": {"PF": {"n_particles": 10}}}
+    assert scale_changes(config) == ["runs: 100 -> 10", "scene Girl last frame: all -> 100"]
+    assert scale_note("paper") is None
+    assert "(runs: 100 -> 10)" in scale_note("quick", ["runs: 100 -> 10"])

@@ -30,13 +30,12 @@ def default_published_values() -> Path:
 
 
 def _scale_note(summaries: dict[str, dict]) -> str | None:
-    """The banner when any stored report is below the paper's scale: what quick changes, per experiment."""
-    quick = {name: s for name, s in summaries.items() if s.get("scale") != "paper"}
+    """The banner when any stored report is below the paper's scale (each experiment's page lists its changes)."""
+    quick = [name for name, s in summaries.items() if s.get("scale") != "paper"]
     if not quick:
         return None
-    changes = [f"{name}: {', '.join(s.get('scale_changes', [])) or 'nothing'}" for name, s in quick.items()]
     return (f"{len(quick)} of {len(summaries)} experiments are at the quick scale. {scale_note('quick')} "
-            f"What it changes: {'; '.join(changes)}.")
+            f"Each experiment's page lists what quick changes for it.")
 
 
 def write_index(reports: Path, published_values: str | Path | None = None) -> Path:

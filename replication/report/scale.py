@@ -7,6 +7,7 @@ the configs.
 """
 
 PAPER_COMMAND = "make replicate SCALE=paper"
+SCALED = ("runs", "scenes", "model", "methods")  # where a config's scale takes effect (not its YAML anchors)
 
 
 def scale_changes(config: dict, path: str = "") -> list[str]:
@@ -16,7 +17,8 @@ def scale_changes(config: dict, path: str = "") -> list[str]:
         if set(config) == {"paper", "quick"}:
             shown = ["all" if v is None else str(v) for v in (config["paper"], config["quick"])]
             return [f"{_where(path)}: {shown[0]} -> {shown[1]}"] if shown[0] != shown[1] else []
-        return [change for key, value in config.items() for change in scale_changes(value, f"{path}.{key}")]
+        return [change for key, value in config.items() if path or key in SCALED
+                for change in scale_changes(value, f"{path}.{key}")]
     if isinstance(config, list):
         return [change for i, value in enumerate(config) for change in scale_changes(value, f"{path}[{i}]")]
     return []
