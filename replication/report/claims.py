@@ -126,6 +126,7 @@ class ClaimTest:
     """How a reading tests its claim; subclasses register by ``name`` and turn records into checks."""
 
     name: ClassVar[str]
+    needs_runs: ClassVar[bool] = True  # False for a test of something computed, not run (point sets)
     registry: ClassVar[dict[str, type["ClaimTest"]]] = {}
 
     def __init_subclass__(cls, **kwargs):
@@ -263,6 +264,7 @@ class Uniformity(ClaimTest):
     each of ``dims`` dimensions.  Deterministic point sets: no runs, no interval."""
 
     name = "uniformity"
+    needs_runs = False
 
     def checks(self, records, tables):
         spec = self.spec
@@ -320,7 +322,7 @@ def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[st
                 if reading.experiment != name:
                     continue
                 test = ClaimTest.of(reading.test, experiment)
-                checks = test.checks(records, tables) if len(records) or reading.test["test"] == "uniformity" else []
+                checks = test.checks(records, tables) if len(records) or not test.needs_runs else []
                 results.setdefault(claim.id, {})[reading.name] = Result.of(checks).as_dict()
     return results
 

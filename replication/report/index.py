@@ -57,7 +57,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     reports.mkdir(parents=True, exist_ok=True)
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
     tallies = cell_tallies(cells)
-    claims_frame(rows, published, papers, tallies).to_csv(reports / "claims.csv", index=False)
+    claims_frame(rows, cells, tallies).to_csv(reports / "claims.csv", index=False)
     page = reports / "index.html"
     page.write_text(
         render(

@@ -106,11 +106,11 @@ def cell_tallies(cells: pd.DataFrame) -> dict[str, str]:
     return tallies
 
 
-def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, papers: list[Paper],
-                 tallies: dict[str, str]) -> pd.DataFrame:
+def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: dict[str, str]) -> pd.DataFrame:
     """``reports/claims.csv``: one row per claim with its verdict, deciding number and interval, runs,
-    why, robustness across readings, and the published cells it owns."""
-    owners = owner_of_cells(papers, published)
+    why, robustness across readings, and the published cells it owns (``cells``: the summary of every
+    cell, with its claim)."""
+    owned = cells["claim"].value_counts()
     table = []
     for paper, claims in rows.items():
         for row in claims:
@@ -122,7 +122,7 @@ def claims_frame(rows: dict[str, list[ClaimRow]], published: pd.DataFrame, paper
                 "runs": deciding.get("runs"), "deciding": deciding.get("what", ""),
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
                 "scale": row.primary.scale,
-                "cells": sum(owner == row.claim.id for owner in owners),
+                "cells": int(owned.get(row.claim.id, 0)),
                 "cell_verdicts": tallies.get(row.claim.id, ""), "note": row.claim.note,
             })
     return pd.DataFrame(table)
