@@ -44,6 +44,27 @@ def test_truth_is_the_box_actually_drawn():
     np.testing.assert_array_equal(scene.visibility[:, 0], 1.0)
 
 
+def test_a_turning_sprite_keeps_its_centre_and_area_and_its_truth_bounds_it():
+    plane = {"shape": "box", "size": [40, 24], "colour": [0, 0, 250], "colour_spread": 0, "structure": True,
+             "motion": {"kind": "scripted", "keyframes": [[0, 60, 40]]}}
+    still = box_scene(frames=3, targets=[plane])
+    scene = box_scene(frames=3, targets=[{**plane, "rotation": [[0, 0], [1, 90], [2, 30]]}])
+    np.testing.assert_array_equal(scene.frame(0), still.frame(0))  # 0 degrees: the rigid sprite
+    # 90 degrees: 24 x 40; 30 degrees: ceil(40 cos 30 + 24 sin 30) x ceil(40 sin 30 + 24 cos 30) = 47 x 41
+    assert scene.truth[1, 0].tolist() == [48, 20, 24, 40] and scene.truth[2, 0].tolist() == [36, 20, 47, 41]
+    for k in range(3):
+        frame = scene.frame(k)
+        np.testing.assert_array_equal(painted_box(frame), scene.truth[k, 0])
+        painted = frame[..., 0] < 53  # more than half covered (blue: 100 outside, 0 body, 10 cross)
+        assert abs(painted.sum() - 40 * 24) <= 0.03 * 40 * 24  # a turn moves pixels, it does not add any
+        ys, xs = np.nonzero(painted)
+        assert abs(xs.mean() - 59.5) < 0.6 and abs(ys.mean() - 39.5) < 0.6  # about the same centre
+    # the dark cross turns with the body: at 90 degrees the long arm is vertical
+    dark = np.all(scene.frame(1) < 40, axis=2)
+    assert np.ptp(np.nonzero(dark)[0]) > np.ptp(np.nonzero(dark)[1])
+    assert np.ptp(np.nonzero(np.all(scene.frame(0) < 40, axis=2))[1]) > 30
+
+
 def test_same_seed_same_frames_in_any_order():
     spec = {
         "size": [64, 48], "frames": 6, "seed": 5, "camera_noise": 3.0,
@@ -123,6 +144,7 @@ def test_velocity_segments_change_speed_suddenly():
         ({"targets": []}, "at least one target"),
         ({"background": {"kind": "plaid"}}, "unknown background"),
         ({"targets": [{"shape": "star", "size": [5, 5], "colour": GREY}]}, "unknown shape"),
+        ({"targets": [{"shape": "box", "size": [5, 5], "colour": GREY, "rotation": [30]}]}, "rotation keyframes"),
     ],
 )
 def test_bad_scene_specs_are_explained(change, message):

@@ -19,6 +19,7 @@ A scene is declared as a dict (from Hydra config), for example::
         appearance: [{start: 90, end: 110, to: back}, {start: 130, end: 140, to: front}]
         motion: {kind: scripted, keyframes: [[0, 60, 50], [149, 260, 180]]}
         scale: [[0, 1.0], [149, 1.4]]
+        rotation: [[0, 0], [149, 30]]  # degrees anticlockwise; the truth box bounds the turned sprite
         depth: 1                     # smaller is nearer
     occluders:
       - {shape: box, size: [40, 120], colour: [20, 20, 20], depth: 0,
@@ -155,6 +156,7 @@ class _Object:
     spec: dict
     centres: np.ndarray
     scales: np.ndarray
+    angles: np.ndarray
     turned: np.ndarray
     sprites: dict
     depth: float
@@ -171,9 +173,23 @@ class _Object:
         if (sw, sh) != (w, h):
             image = cv2.resize(image, (sw, sh), interpolation=cv2.INTER_LINEAR)
             alpha = cv2.resize(alpha, (sw, sh), interpolation=cv2.INTER_LINEAR)
+        if self.angles[k] != 0:
+            image, alpha = _rotated(image, alpha, self.angles[k])
+            sh, sw = alpha.shape
         x0 = int(round(self.centres[k, 0] - sw / 2))
         y0 = int(round(self.centres[k, 1] - sh / 2))
         return image, alpha, x0, y0
+
+
+def _rotated(image: np.ndarray, alpha: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
+    """A sprite turned by ``degrees`` (anticlockwise) about its centre, on the smallest canvas that holds it."""
+    h, w = alpha.shape
+    cos, sin = abs(np.cos(np.radians(degrees))), abs(np.sin(np.radians(degrees)))
+    nw, nh = (int(np.ceil(v - 1e-6)) for v in (w * cos + h * sin, w * sin + h * cos))
+    turn = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), float(degrees), 1.0)
+    turn[:, 2] += ((nw - w) / 2, (nh - h) / 2)
+    return (cv2.warpAffine(image, turn, (nw, nh), flags=cv2.INTER_LINEAR),
+            cv2.warpAffine(alpha, turn, (nw, nh), flags=cv2.INTER_LINEAR))
 
 
 def _clip(x0: int, y0: int, w: int, h: int, width: int, height: int):
@@ -218,13 +234,16 @@ class SyntheticScene:
                              self.n_frames, self.size, rng)
         keys = np.asarray(spec.get("scale", [[0, 1.0]]), dtype=float)
         scales = np.interp(frames, keys[:, 0], keys[:, 1])
+        turns = np.asarray(spec.get("rotation", [[0, 0.0]]), dtype=float)
+        _require(turns.ndim == 2 and turns.shape[1] == 2, "rotation keyframes are [frame, degrees] rows")
+        angles = np.interp(frames, turns[:, 0], turns[:, 1])
         turned = np.zeros(self.n_frames)
         for change in spec.get("appearance", []):
             _require(change.get("to") in ("back", "front"), "appearance changes go 'to: back' or 'to: front'")
             ramp = _ramp(frames, change["start"], change["end"])
             turned = np.maximum(turned, ramp) if change["to"] == "back" else np.minimum(turned, 1.0 - ramp)
         sprites = {"front": sprite(spec, "front", rng), "back": sprite(spec, "back", rng)}
-        return _Object(spec, centres, scales, turned, sprites, float(spec.get("depth", 1.0)), target)
+        return _Object(spec, centres, scales, angles, turned, sprites, float(spec.get("depth", 1.0)), target)
 
     def _background(self, spec: dict, rng: np.random.Generator) -> np.ndarray:
         kind = spec.get("kind", "flat")
