@@ -6,9 +6,9 @@ from scipy.special import ndtri
 from scipy.stats import qmc as scipy_qmc
 
 from replication.filters.qmc import (
-    GoodPointSetProposal,
     NQMCProposal,
     SQMCProposal,
+    SupportBoxProposal,
     gps_qmcpf,
     nqmcpf,
     tr_sqmc,
@@ -127,18 +127,27 @@ def test_nqmcpf_draws_the_prior_through_the_inverse_normal_cdf():
     x, lw = NQMCProposal(randomise=False)(MODEL, particles, log_weights, 1, np.random.default_rng(0))
     np.testing.assert_allclose(x, MODEL.a * particles + np.sqrt(MODEL.Q) * ndtri(halton(8, 1)[:, 0]))
     np.testing.assert_array_equal(lw, log_weights)
+    assert isinstance(nqmcpf(8).proposal, NQMCProposal)  # the default reading: prior-driven
 
 
-def test_gps_proposal_maps_good_points_into_the_box_and_weights_by_the_mixture():
+@pytest.mark.parametrize(
+    "proposal",
+    [
+        gps_qmcpf(20, randomise=False, width=2.0).proposal,  # GPS-QMCPF: the good points
+        nqmcpf(20, randomise=False, proposal="support_box", width=2.0).proposal,  # §1.2: Halton points
+    ],
+    ids=["good_cos", "halton"],
+)
+def test_support_box_maps_the_points_into_the_box_and_weights_by_the_mixture(proposal):
     rng = np.random.default_rng(0)
     particles, log_weights = rng.standard_normal(20), np.log(rng.dirichlet(np.ones(20)))
-    proposal = GoodPointSetProposal(randomise=False, width=2.0)
+    assert isinstance(proposal, SupportBoxProposal)
     x, lw = proposal(MODEL, particles, log_weights, 1, rng)
     w = np.exp(log_weights)
     means = MODEL.a * particles
     m, sd = w @ means, np.sqrt(w @ (means - w @ means) ** 2 + MODEL.Q)
     a, b = m - 2.0 * sd, m + 2.0 * sd
-    np.testing.assert_allclose(x, a + (b - a) * good_point_set(20, 1)[:, 0])  # eq (6)
+    np.testing.assert_allclose(x, a + (b - a) * point_set(proposal.points, 20, 1)[:, 0])  # eq (6)
     mixture = np.exp(MODEL.transition_log_density(x[:, None], particles[None, :], 1)) @ w  # eq (7)
     np.testing.assert_allclose(np.exp(lw), mixture * (b - a) / 20)  # eq (8) before the likelihood, / N
 
@@ -166,10 +175,16 @@ def rms_gap_to_kalman(build, n, repeats=8):
     return float(np.sqrt(np.mean(np.square(gaps))))
 
 
-@pytest.mark.parametrize(("name", "tolerance"), [("nqmcpf", 0.05), ("gps_qmcpf", 0.01), ("tr_sqmc", 0.04)])
+SUPPORT_BOX = {"nqmcpf_support_box": lambda n: nqmcpf(n, ess_threshold=0.0, proposal="support_box")}
+
+
+@pytest.mark.parametrize(
+    ("name", "tolerance"),
+    [("nqmcpf", 0.05), ("gps_qmcpf", 0.01), ("tr_sqmc", 0.04), ("nqmcpf_support_box", 0.01)],
+)
 def test_qmc_filters_converge_to_the_kalman_filter(name, tolerance):
     """Posterior sd is about 0.6; bootstrap PF's gap at N = 400 is about 0.045."""
-    small, large = (rms_gap_to_kalman(BUILDERS[name], n) for n in (50, 400))
+    small, large = (rms_gap_to_kalman((BUILDERS | SUPPORT_BOX)[name], n) for n in (50, 400))
     assert large < tolerance, (small, large)
     assert large < 0.6 * small, (small, large)
 
@@ -210,6 +225,12 @@ def test_non_randomised_filters_ignore_the_seed(build):
 def test_bad_filter_arguments_are_refused():
     with pytest.raises(ValueError, match="point set"):
         nqmcpf(100, points="sobol")
+    with pytest.raises(
+        ValueError, match=r"NQMCPF proposal 'mixture'; choose one of \('prior', 'support_box'\)"
+    ):
+        nqmcpf(100, proposal="mixture")
+    with pytest.raises(ValueError, match="width"):
+        nqmcpf(100, proposal="support_box", width=-1.0)
     with pytest.raises(ValueError, match="width"):
         gps_qmcpf(100, width=0.0)
     with pytest.raises(ValueError, match="resampling scheme"):

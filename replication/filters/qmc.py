@@ -3,7 +3,8 @@
 Each is the one loop of :mod:`replication.smc.loop` with its own proposal;
 the proposal also draws x_0 (gps_qmcpf §2.3 step 1) through :class:`QMCParticleFilter`.
 They need a model with additive Gaussian noise (:class:`AdditiveGaussianModel`):
-``f(x, t)``, ``Q``, ``x0``, ``P0``; GPS-QMCPF also ``transition_log_density``.
+``f(x, t)``, ``Q``, ``x0``, ``P0``; the support-box proposal (GPS-QMCPF, NQMCPF's
+``support_box``) also ``transition_log_density``.
 States are scalars (particles of shape (N,)) or d-vectors (shape (N, d), with
 Q and P0 scalars, per-coordinate variances or covariance matrices).
 
@@ -25,6 +26,8 @@ from replication.qmc import POINT_SETS, point_set, random_shift
 from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy
 from replication.smc.resampling import inverse_cdf
 from replication.smc.weights import logsumexp
+
+NQMCPF_PROPOSALS = ("prior", "support_box")
 
 
 def _gaussian(mean, cov, u: np.ndarray) -> np.ndarray:
@@ -94,7 +97,7 @@ class NQMCProposal(_PointSource):
     "no sources found"); this is the QMC-PF of baselines.md §6 (Guo & Wang 2006;
     Ormoneit et al. 2001): the bootstrap filter with the normal draws of the
     prior replaced by Halton points through the inverse normal CDF.  The
-    support-box QMCPF of gps_qmcpf §1.2 is ``gps_qmcpf(points="halton")``.
+    support-box QMCPF of gps_qmcpf §1.2 is ``nqmcpf(proposal="support_box")``.
     """
 
     def __call__(self, model, particles, log_weights, t, rng):
@@ -107,8 +110,10 @@ class NQMCProposal(_PointSource):
 
 
 @dataclass(frozen=True)
-class GoodPointSetProposal(_PointSource):
-    """GPS-QMCPF, gps_qmcpf §2.3 steps 2-3: the good points mapped into a support box.
+class SupportBoxProposal(_PointSource):
+    """The support-box QMCPF: gps_qmcpf §2.3 steps 2-3 with the good points (GPS-QMCPF), and §1.2's
+    standard QMCPF with Halton points ("generate a support interval to map the low-discrepancy particle
+    set at time k; then compute the weights at time k from the distribution of all particles at k-1").
 
     Support box [a_k, b_k] = m ± c s per coordinate, where m and s^2 are the
     mean and variance of the predictive mixture sum_j w_{k-1}^j N(f(x_{k-1}^j), Q)
@@ -197,11 +202,20 @@ def nqmcpf(
     ess_threshold: float = 1.0,
     randomise: bool = True,
     points: str = "halton",
+    proposal: str = "prior",
+    width: float = 4.0,
 ) -> QMCParticleFilter:
-    """NQMCPF (:class:`NQMCProposal`): Halton points through Phi^-1 for the prior; resampling as bootstrap."""
-    return QMCParticleFilter(
-        n_particles, ResamplingPolicy(resampling, ess_threshold), proposal=NQMCProposal(randomise, points)
-    )
+    """NQMCPF with one of NQMCPF_PROPOSALS: ``"prior"`` (:class:`NQMCProposal`), Halton points through
+    Phi^-1 for the prior, resampling as bootstrap; ``"support_box"`` (:class:`SupportBoxProposal`), the
+    standard QMCPF of gps_qmcpf §1.2: the points on the box m ± width s, weighted by the predictive
+    mixture times the likelihood (``width`` is used by this one only)."""
+    if proposal == "prior":
+        source = NQMCProposal(randomise, points)
+    elif proposal == "support_box":
+        source = SupportBoxProposal(randomise, points, width)
+    else:
+        raise ValueError(f"unknown NQMCPF proposal {proposal!r}; choose one of {NQMCPF_PROPOSALS}")
+    return QMCParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), proposal=source)
 
 
 def gps_qmcpf(
@@ -212,7 +226,7 @@ def gps_qmcpf(
     points: str = "good_cos",
     width: float = 4.0,
 ) -> QMCParticleFilter:
-    """GPS-QMCPF (:class:`GoodPointSetProposal`): good points on the box m ± width s, mixture weights.
+    """GPS-QMCPF (:class:`SupportBoxProposal`): good points on the box m ± width s, mixture weights.
 
     The mixture of eq (7) carries the weights, so the filter needs no
     resampling (default ``ess_threshold=0``); resampling only adds noise to it.
@@ -220,7 +234,7 @@ def gps_qmcpf(
     return QMCParticleFilter(
         n_particles,
         ResamplingPolicy(resampling, ess_threshold),
-        proposal=GoodPointSetProposal(randomise, points, width),
+        proposal=SupportBoxProposal(randomise, points, width),
     )
 
 
