@@ -222,3 +222,27 @@ def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability"}
     table = Rating(spec, experiment, published).build(records).frame
     assert set(table["rating"]) <= {"good", "medium", "poor"} and len(table) == 2
+
+
+@pytest.mark.parametrize("noise_on", ["velocity", "position"])
+def test_constant_velocity_noise_on_velocity_or_position(noise_on):
+    """The balls' motion (bis_pf section 3.2): without noise the centre moves by v exactly; noise on
+    velocity moves the centre by a / 2 and v by a (eq 14, T = 1), noise on position moves the centre by
+    accel_sd e and leaves v as it was; the size steps are the same either way."""
+    from replication.models.box import BoxModel
+
+    state = np.array([[10.0, 20.0, 20.0, 20.0, 1.5, -0.5]])  # (cx, cy, w, h, vx, vy)
+    still = BoxModel(state[0, :4], None, kind="constant_velocity", accel_sd=0.0, step_sd=(0, 0, 0, 0), noise_on=noise_on)
+    np.testing.assert_array_equal(still.propagate(state, 1, np.random.default_rng(0)), [[11.5, 19.5, 20, 20, 1.5, -0.5]])
+    model = BoxModel(state[0, :4], None, kind="constant_velocity", accel_sd=2.0, step_sd=(0, 0, 0.1, 0.1), noise_on=noise_on)
+    e = np.random.default_rng(5).standard_normal((1, 4))  # propagate draws (e_x, e_y) then the size steps
+    moved = model.propagate(state, 1, np.random.default_rng(5))
+    np.testing.assert_allclose(moved[0, 2:4], 20 + 0.1 * e[0, 2:4])
+    if noise_on == "velocity":
+        np.testing.assert_allclose(moved[0, :2], [11.5, 19.5] + 2.0 * e[0, :2] / 2)
+        np.testing.assert_allclose(moved[0, 4:], [1.5, -0.5] + 2.0 * e[0, :2])
+    else:
+        np.testing.assert_allclose(moved[0, :2], [11.5, 19.5] + 2.0 * e[0, :2])
+        np.testing.assert_array_equal(moved[0, 4:], [1.5, -0.5])
+    with pytest.raises(ValueError, match="noise_on"):
+        BoxModel(state[0, :4], None, kind="constant_velocity", noise_on="size")

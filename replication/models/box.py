@@ -8,6 +8,10 @@ the velocities vx, vy.  Motions:
 * ``constant_velocity``: gps_qmcpf eq (14) with period T: the centre moves by
   v T + a T^2 / 2 and the velocity by a T, a ~ N(0, accel_sd^2); the size takes
   a random perturbation (fusion_pf's "first-order dynamics for the centre").
+  With ``noise_on: position`` the disturbance enters the centre instead: it
+  moves by v T + accel_sd e and v stays (bis_pf section 3.2, "constant
+  velocity disturbed by Gaussian noise ... a random walk", read as noise on
+  position); v starts at 0, so the centre then takes a random walk.
 
 Sizes are kept at least ``min_size`` px.  The observation is an image; the
 likelihood is a :class:`replication.vision.ColourLikelihood` (or any object
@@ -20,6 +24,7 @@ from typing import Any
 import numpy as np
 
 MOTIONS = ("random_walk", "constant_velocity")
+NOISE_ON = ("velocity", "position")  # where a constant-velocity model's disturbance enters
 
 
 @dataclass
@@ -32,6 +37,7 @@ class BoxModel:
     step_sd: tuple[float, float, float, float] = (4.0, 4.0, 0.5, 0.5)  # cx, cy, w, h (random walk)
     accel_sd: float = 1.0  # constant velocity: sd of the acceleration, px / frame^2
     period: float = 1.0  # T of gps_qmcpf eq (14)
+    noise_on: str = "velocity"  # constant velocity: the disturbance accelerates (eq 14) or displaces the centre
     initial_sd: tuple[float, float, float, float] = (2.0, 2.0, 0.5, 0.5)
     min_size: float = 2.0
     cache: dict = field(default_factory=dict, repr=False)  # frame features; shared by a run's targets
@@ -40,6 +46,8 @@ class BoxModel:
     def __post_init__(self):
         if self.kind not in MOTIONS:
             raise ValueError(f"unknown motion {self.kind!r}; choose one of {MOTIONS}")
+        if self.noise_on not in NOISE_ON:
+            raise ValueError(f"unknown noise_on {self.noise_on!r}; choose one of {NOISE_ON}")
         self.initial_box = np.asarray(self.initial_box, dtype=float)
         self.step_sd = np.asarray(self.step_sd, dtype=float)
         self.initial_sd = np.asarray(self.initial_sd, dtype=float)
@@ -67,12 +75,16 @@ class BoxModel:
 
     @property
     def noise_factor(self) -> np.ndarray:
-        """W of x_t = A x_{t-1} + W e, e ~ N(0, I): (d, 4) (eq 14: accelerations of x and y, size steps)."""
+        """W of x_t = A x_{t-1} + W e, e ~ N(0, I): (d, 4) (eq 14: accelerations of x and y, size steps;
+        with noise on position, steps of the centre that leave v alone)."""
         if self.kind == "random_walk":
             return np.diag(self.step_sd)
         w = np.zeros((6, 4))
-        w[[0, 1], [0, 1]] = self.accel_sd * self.period**2 / 2
-        w[[4, 5], [0, 1]] = self.accel_sd * self.period
+        if self.noise_on == "position":
+            w[[0, 1], [0, 1]] = self.accel_sd
+        else:
+            w[[0, 1], [0, 1]] = self.accel_sd * self.period**2 / 2
+            w[[4, 5], [0, 1]] = self.accel_sd * self.period
         w[[2, 3], [2, 3]] = self.step_sd[2:4]
         return w
 
