@@ -7,6 +7,7 @@ from replication.filters import FILTERS
 from replication.filters.ism import ISMMove
 from replication.filters.pso import PSOMove
 from replication.models import LinearGaussian
+from replication.vision.likelihood import gaussian_similarity_log_likelihood
 
 
 class Stub:
@@ -51,7 +52,7 @@ def test_personal_bests_only_look_back_over_the_window():
     for k, value in enumerate(best_first):
         positions = np.array([[float(k)], [100.0]])
         move(positions, lambda x, v=value: np.log(np.array([v, 0.1])), rng)
-    personal, personal_value, leader, leader_value = move.bests()
+    personal, personal_value, leader, leader_value = move.best_positions(move.scores(None))
     assert len(move.history) == 3
     assert personal_value[0] == 0.4 and personal[0, 0] == 2.0  # frames 2..4 only: frame 0's 0.9 is forgotten
     assert leader_value == 0.4 and leader[0] == 2.0
@@ -62,6 +63,84 @@ def test_ism_settings_are_checked():
         ISMMove(c1=0.8, c2=0.8)
     with pytest.raises(ValueError, match="unknown ISM update"):
         ISMMove(update="sideways")
+    for option in ("bests", "v_memory", "moves"):
+        with pytest.raises(ValueError, match=f"unknown ISM {option} 'sideways'; choose one of"):
+            ISMMove(**{option: "sideways"})
+
+
+def _table(values):
+    """A likelihood that gives F = values[x] at the 1-D position x."""
+    return lambda x: np.log([values[float(p)] for p in x[:, 0]])
+
+
+@pytest.mark.parametrize("bests, leader, u1", [("stored", 0.0, [0.1, -0.8]), ("rescored", 2.0, [0.5, -0.4])])
+def test_rescored_bests_pick_the_current_frames_best(bests, leader, u1):
+    # frame 0: particle 0 at A = 0 scores 0.9; frame 1: it is at B = 2, which scores 0.5 now, while A scores 0.05 now
+    # (particle 1: 5 scored 0.3 then, 0.01 now; 6 scores 0.2 now)
+    move = ISMMove(window=30, bests=bests)
+    rng = Stub(uniforms=[[0.5, 0.5], [0.5, 0.5]], normals=np.ones((6, 2)))
+    move(np.array([[0.0], [5.0]]), _table({0.0: 0.9, 5.0: 0.3}), rng)
+    evaluated = []
+    frame1 = _table({0.0: 0.05, 2.0: 0.5, 5.0: 0.01, 6.0: 0.2})
+    move(np.array([[2.0], [6.0]]), lambda x: evaluated.append(len(x)) or frame1(x), rng)
+    personal, personal_value, best, best_value = move.best_positions(move.scores(frame1))
+    assert best[0] == leader  # stored: A by its old 0.9; rescored: B, the best on the current frame
+    assert personal[1, 0] == (5.0 if bests == "stored" else 6.0)
+    # eq (10), randn = 1: frame 0 gives u1 = 0.5 + [0.9, 0.3] - 0.9; frame 1 adds [0.5, 0.2] - F(p_g),
+    # F(p_g) = 0.9 stored (A's old score) or 0.5 rescored (B's)
+    np.testing.assert_allclose(move.u[0], u1)
+    # re-scoring is paid: the earlier frame's N positions are evaluated on the current frame in one call
+    assert evaluated == ([2] if bests == "stored" else [2, 2])
+
+
+@pytest.mark.parametrize("v_memory, carried", [("carried", -0.2), ("reset", 0.0)])
+def test_v_reset_carries_no_velocity_from_the_previous_frame(v_memory, carried):
+    move = ISMMove(v_memory=v_memory)
+    rng = Stub(uniforms=[[0.5, 0.25], [1.0, 0.5]], normals=np.ones((6, 2)))
+    move(np.array([[1.0], [3.0]]), likelihood_table, rng)  # eq (12): v1 = 0.1 * 1 * (1 - 3) for particle 1
+    np.testing.assert_allclose(move.v[0, :, 0], [0.0, -0.2])
+    # frame 1: both particles sit on the global and their personal best, so eqs (12)-(13) add nothing
+    moved, _ = move(np.array([[1.0], [1.0]]), likelihood_table, rng)
+    np.testing.assert_allclose(move.v[0, :, 0], [0.0, carried])
+    np.testing.assert_allclose(move.v[1], 0.0)
+    t1, t2 = 1 / move.u[0, 1] + carried, 1 / move.u[1, 1]  # eqs (14)-(15) with randn = 1
+    np.testing.assert_allclose(moved[1, 0], 1.0 + 0.8 * t1 + 0.2 * t2)
+
+
+@pytest.mark.parametrize("update", ["additive", "replace"])
+def test_position_moves_leave_width_and_height_to_the_motion_model(update):
+    particles = np.array([[10.0, 20.0, 30.0, 40.0], [12.0, 21.0, 28.0, 44.0]])
+
+    def log_likelihood(x):
+        return -0.5 * ((x[:, 0] - 11.0) ** 2 + (x[:, 2] - 29.0) ** 2)
+
+    def moved(moves):
+        rng = Stub(uniforms=[[0.5, 0.25], [1.0, 0.5]], normals=[[1, 2], [3, 4], [0.5, 1], [1, 0.5], [2, 2], [1, 1]])
+        return ISMMove(update=update, moves=moves)(particles, log_likelihood, rng)[0]
+
+    box, position = moved("box"), moved("position")
+    np.testing.assert_array_equal(position[:, 2:], particles[:, 2:])  # w, h untouched
+    np.testing.assert_array_equal(position[:, :2], box[:, :2])  # (x, y) take the same ISM step
+    assert np.all(box[:, 2:] != particles[:, 2:])  # while box moves w, h with the same scalar
+
+
+def test_eqs_10_11_leave_u_unchanged_when_f_is_as_small_as_sigma_c_003_makes_it():
+    # sigma_c = 0.03 (eq 30): rho = 0.83 gives F = 1e-40, rho = 0.57 gives F = 1e-103, the range measured
+    # on the office stand-in and Girl; u ~ U(0, 1) cannot register a change of 1e-40 in float64
+    def small(x):
+        return gaussian_similarity_log_likelihood(np.where(x[:, 0] == 1.0, 0.83, 0.57), 0.03)
+
+    assert np.allclose(np.log10(np.exp(small(np.array([[1.0], [3.0]])))), [-40, -103], atol=1.5)
+    uniforms = np.array([[0.5, 0.25], [1.0, 0.5]])
+    rng = Stub(uniforms=uniforms.copy(), normals=[[1, 2], [3, 4], [0.5, 1], [1, 0.5], [2, 2], [1, 1]])
+    move = ISMMove()
+    move(np.array([[1.0], [3.0]]), small, rng)
+    np.testing.assert_array_equal(move.u, uniforms)
+    # at rho = 1 (F = 13.3, a perfect match) the same update does move u
+    perfect = ISMMove()
+    perfect(np.array([[1.0], [3.0]]), lambda x: gaussian_similarity_log_likelihood(np.where(x[:, 0] == 1.0, 1.0, 0.57), 0.03),
+            Stub(uniforms=uniforms.copy(), normals=[[1, 2], [3, 4], [0.5, 1], [1, 0.5], [2, 2], [1, 1]]))
+    assert perfect.u[0, 1] != uniforms[0, 1]
 
 
 def test_pso_climbs_towards_the_likelihood_peak_within_the_velocity_clamp():
@@ -76,6 +155,21 @@ def test_pso_climbs_towards_the_likelihood_peak_within_the_velocity_clamp():
     np.testing.assert_array_equal(correction, 0.0)
     unmoved, _ = PSOMove(iterations=0, max_velocity=(0.5,))(particles, log_likelihood, np.random.default_rng(2))
     np.testing.assert_array_equal(unmoved, particles)
+
+
+@pytest.mark.parametrize("personal_bests, expected", [("frame", [3.0, 9.0]), ("history", [3.0, 7.0])])
+def test_pso_history_bests_are_kept_across_frames(personal_bests, expected):
+    # c2 = 0 and r1 = 0.5: one iteration moves each particle half-way to its personal best
+    move = PSOMove(iterations=1, c1=1.0, c2=0.0, max_velocity=(100.0,), personal_bests=personal_bests)
+    rng = Stub(uniforms=[[0.5], [0.5]], normals=[])
+    frame0, _ = move(np.array([[0.0], [5.0]]), lambda x: np.zeros(len(x)), rng)  # flat: nothing moves
+    # frame 1 peaks at 5, where particle 1 was at frame 0: re-scored now, 5 beats its predicted 9 (0 > -16),
+    # while particle 0's predicted 3 beats its old 0 (-4 > -25)
+    moved, _ = move(np.array([[3.0], [9.0]]), lambda x: -((x[:, 0] - 5.0) ** 2), rng)
+    np.testing.assert_allclose(moved[:, 0], expected)
+    assert len(move.history) == (2 if personal_bests == "history" else 0)
+    with pytest.raises(ValueError, match="unknown PSO personal_bests 'all'; choose one of"):
+        PSOMove(personal_bests="all")
 
 
 def test_pso_stops_once_the_global_best_is_good_enough():

@@ -24,6 +24,19 @@ update x <- x + v that eqs (12)-(13) imitate (``update: additive``, the
 default); ``update: replace`` is the literal reading.  The move returns no
 weight correction: particles are weighted by the likelihood where they land
 (eq 29).
+
+Three further choices the paper leaves open are named options:
+
+* ``bests``: ``stored`` compares the positions of the window by the F each
+  had on its own frame; ``rescored`` re-scores them on the current frame
+  before picking p_j and p_g (section 5.2 puts ISM-PF's cost in computing the
+  personal bests over "the last 30 historical moments", which only costs
+  anything if old positions are re-evaluated).
+* ``v_memory``: ``carried`` lets v_{1,k}, v_{2,k} of eqs (12)-(13) start from
+  the previous frame's v (v is zeroed only at Step 0); ``reset`` starts them
+  at zero every frame.
+* ``moves``: ``box`` applies the ISM step to every coordinate of (x, y, w, h);
+  ``position`` to (x, y) only, leaving w, h to the motion model (eq 28).
 """
 
 from dataclasses import dataclass, field
@@ -33,6 +46,9 @@ import numpy as np
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 
 UPDATES = ("additive", "replace")
+BESTS = ("stored", "rescored")
+V_MEMORY = ("carried", "reset")
+MOVES = ("box", "position")
 
 
 @dataclass
@@ -42,22 +58,35 @@ class ISMMove:
     tau1: float = 0.1
     window: int = 30
     update: str = "additive"
+    bests: str = "stored"
+    v_memory: str = "carried"
+    moves: str = "box"
     u: np.ndarray | None = field(default=None, repr=False)
     v: np.ndarray | None = field(default=None, repr=False)
     history: list = field(default_factory=list, repr=False)
 
     def __post_init__(self):
-        if self.update not in UPDATES:
-            raise ValueError(f"unknown ISM update {self.update!r}; choose one of {UPDATES}")
+        for option, allowed in (("update", UPDATES), ("bests", BESTS), ("v_memory", V_MEMORY), ("moves", MOVES)):
+            if getattr(self, option) not in allowed:
+                raise ValueError(f"unknown ISM {option} {getattr(self, option)!r}; choose one of {allowed}")
         if self.window < 1:
             raise ValueError(f"the personal-best window must be at least 1 frame, got {self.window}")
         if not np.isclose(self.c1 + self.c2, 1.0):
             raise ValueError(f"ism_pf requires c1 + c2 = 1, got {self.c1} + {self.c2}")
 
-    def bests(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-        """Personal bests p_j and F(p_j) over the window, and the global best p_g and F(p_g)."""
+    def scores(self, log_likelihood) -> np.ndarray:
+        """F of every position in the window, (frames, N): as stored on its own frame, or re-scored
+        on the current frame's likelihood (``bests: rescored``) in one call over all earlier frames."""
+        stored = np.stack([h[1] for h in self.history])
+        if self.bests == "stored" or len(self.history) == 1:
+            return stored
+        earlier = np.stack([h[0] for h in self.history[:-1]])  # (frames - 1, N, d)
+        rescored = np.exp(log_likelihood(earlier.reshape(-1, earlier.shape[-1]))).reshape(earlier.shape[:2])
+        return np.vstack([rescored, stored[-1:]])
+
+    def best_positions(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """Personal bests p_j and F(p_j) over the window scored by ``values``, and the global best p_g and F(p_g)."""
         positions = np.stack([h[0] for h in self.history])  # (frames, N, d)
-        values = np.stack([h[1] for h in self.history])  # (frames, N)
         frame = np.argmax(values, axis=0)
         columns = np.arange(values.shape[1])
         personal, personal_value = positions[frame, columns], values[frame, columns]
@@ -68,10 +97,11 @@ class ISMMove:
         n = len(particles)
         if self.u is None:
             self.u = rng.random((2, n))
+        if self.v is None or self.v_memory == "reset":
             self.v = np.zeros((2, *particles.shape))
         fitness = np.exp(log_likelihood(particles))  # F, the likelihood itself (eq 30)
         self.history = (self.history + [(particles.copy(), fitness)])[-self.window :]
-        personal, personal_value, leader, leader_value = self.bests()
+        personal, personal_value, leader, leader_value = self.best_positions(self.scores(log_likelihood))
         noise = rng.standard_normal((6, n))
         self.u[0] += noise[0] * (fitness - leader_value)  # eq (10)
         self.u[1] += noise[1] * (fitness - personal_value)  # eq (11)
@@ -81,7 +111,9 @@ class ISMMove:
             t1 = (noise[4] / self.u[0])[:, None] + self.v[0]  # eq (14)
             t2 = (noise[5] / self.u[1])[:, None] + self.v[1]  # eq (15)
         step = self.c1 * t1 + self.c2 * t2  # eq (16)
-        moved = particles + step if self.update == "additive" else step
+        axes = slice(None) if self.moves == "box" else slice(0, 2)  # (x, y, w, h) or (x, y)
+        moved = particles.copy()
+        moved[:, axes] = (particles[:, axes] if self.update == "additive" else 0.0) + step[:, axes]
         return np.where(np.isfinite(moved), moved, particles), np.zeros(n)
 
 
