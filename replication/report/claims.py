@@ -77,6 +77,7 @@ class Check:
     verdict: Verdict
     estimate: Estimate | None = None
     unit: str = ""
+    reference: float | None = None  # where the claim's line is: the paper's value, a bound, zero difference
 
     @property
     def number(self) -> str:
@@ -116,7 +117,8 @@ class Result:
             e = c.estimate
             return {"what": c.what, "verdict": c.verdict.as_dict(), "number": c.number,
                     "value": _number(e.value) if e else None, "low": _number(e.low) if e else None,
-                    "high": _number(e.high) if e else None, "runs": e.runs if e else None}
+                    "high": _number(e.high) if e else None, "runs": e.runs if e else None,
+                    "reference": c.reference}
 
         return {"verdict": self.verdict.as_dict(), "checks": [check(c) for c in self.checks],
                 "deciding": check(self.deciding) if self.deciding else None}
@@ -144,6 +146,11 @@ class ClaimTest:
 
     def checks(self, records: pd.DataFrame, tables: dict[str, Table]) -> list[Check]:
         raise NotImplementedError
+
+    @property
+    def tables(self) -> list[str]:
+        """The names of the experiment's tables the test judges (none: it judges the records)."""
+        return []
 
     def conditions(self, records: pd.DataFrame) -> list[str]:
         return [str(c) for c in _listed(self.spec.get("conditions"))] or list(dict.fromkeys(records["condition"]))
@@ -177,7 +184,7 @@ class Order(ClaimTest):
                         continue
                     difference = paired_difference(paired["method"] * scale, paired["baseline"] * scale)
                     allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean() * scale)
-                    found.append(Check(what, _judge_sign(difference, lower, allowed), difference, unit))
+                    found.append(Check(what, _judge_sign(difference, lower, allowed), difference, unit, 0.0))
         return found
 
 
@@ -186,9 +193,13 @@ class Cells(ClaimTest):
 
     name = "cells"
 
+    @property
+    def tables(self):
+        return _listed(self.spec["tables"])
+
     def checks(self, records, tables):
         found = []
-        for name in _listed(self.spec["tables"]):
+        for name in self.tables:
             table = tables.get(name)
             for entry in [] if table is None else table.cells:
                 estimate = None
@@ -200,7 +211,7 @@ class Cells(ClaimTest):
                 verdict = Verdict.from_dict(entry["verdict"]) if entry["verdict"] else Verdict(Outcome.NOT_TESTABLE)
                 if isinstance(entry["ours"], str):  # a rating: the proportion of runs behind it is the number
                     what = f"{what} (ours: {entry['ours']})"
-                found.append(Check(what, verdict, estimate))
+                found.append(Check(what, verdict, estimate, reference=_number(_float(entry.get("paper")))))
         return found
 
 
@@ -224,7 +235,7 @@ class Threshold(ClaimTest):
             bound_ = bound if above else -bound
             verdict = (Verdict(Outcome.REPRODUCED) if low >= bound_ else Verdict(Outcome.NOT_REPRODUCED)
                        if high < bound_ else Verdict(Outcome.INCONCLUSIVE, "the interval straddles the bound"))
-        return [Check(what, verdict, found, spec.get("unit", ""))]
+        return [Check(what, verdict, found, spec.get("unit", ""), float(bound))]
 
 
 class Best(ClaimTest):
@@ -256,7 +267,7 @@ class Best(ClaimTest):
         else:
             verdict = Verdict(Outcome.INCONCLUSIVE, f"first in {share:.0%} of resamples")
         return [Check(what, verdict, Estimate(share, math.nan, math.nan, len(means), "bootstrap over sequences"),
-                      " of resamples first")]
+                      " of resamples first", STABLE)]
 
 
 class Uniformity(ClaimTest):
@@ -329,6 +340,14 @@ def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[st
 
 def _listed(value) -> list:
     return [] if value is None else list(value) if isinstance(value, (list, tuple)) else [value]
+
+
+def _float(value) -> float:
+    """A published value as a number (NaN for a rating or an empty cell)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def _number(value) -> float | None:

@@ -149,7 +149,8 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
         "verdict": [r.verdict.outcome.value for r in rows],
         "deciding number (95% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
         "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
-        "readings": [r.primary.reading.name + ("" if len(r.results) == 1 else f"; {r.robustness}") for r in rows],
+        "readings": [r.primary.reading.name + ("" if len(r.results) == 1 and r.multiverse is None
+                                               else f"; {r.robustness}") for r in rows],
     })
 
 

@@ -30,6 +30,8 @@ class ReadingResult:
 class ClaimRow:
     claim: Claim
     results: tuple[ReadingResult, ...]
+    multiverse: dict | None = None  # its robustness across the paper's multiverse, as stored (if it was run)
+    multiverse_experiment: str = ""
 
     @property
     def primary(self) -> ReadingResult:
@@ -45,8 +47,17 @@ class ClaimRow:
         return list(dict.fromkeys((r.reading.experiment, r.scale) for r in self.results if r.scale))
 
     @property
+    def robust(self) -> bool | None:
+        """The same verdict in every case of the paper's multiverse (None: not run, or too few cases)."""
+        return None if self.multiverse is None else self.multiverse["robust"]
+
+    @property
     def robustness(self) -> str:
-        """Whether the verdict is the same under every reading, or which reading it hinges on."""
+        """Whether the verdict is the same under every reading, or which reading it hinges on: across the
+        paper's multiverse of run-level and scoring readings where it was run, else across the scoring
+        readings of the stored results."""
+        if self.multiverse is not None:
+            return self.multiverse["summary"]
         judged = [r for r in self.results if r.verdict.outcome is not Outcome.NOT_TESTABLE]
         if len(self.results) == 1:
             return "one reading"
@@ -60,8 +71,12 @@ class ClaimRow:
 
 
 def claim_rows(papers: list[Paper], summaries: dict[str, dict]) -> dict[str, list[ClaimRow]]:
-    """Per paper, its claims with every reading's stored result (not testable where none is stored)."""
-    return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings))
+    """Per paper, its claims with every reading's stored result (not testable where none is stored), and
+    its robustness across the paper's multiverse where one was run."""
+    across = {claim: (name, stored) for name, summary in summaries.items()
+              for claim, stored in summary.get("multiverse", {}).items()}
+    return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings),
+                                 across.get(claim.id, ("", None))[1], across.get(claim.id, ("", None))[0])
                         for claim in paper.claims] for paper in papers}
 
 
@@ -121,8 +136,25 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
                 "number": deciding.get("value"), "ci_low": deciding.get("low"), "ci_high": deciding.get("high"),
                 "runs": deciding.get("runs"), "deciding": deciding.get("what", ""),
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
+                "robust": row.robust, **_across(row),
                 "scale": row.primary.scale,
                 "cells": int(owned.get(row.claim.id, 0)),
                 "cell_verdicts": tallies.get(row.claim.id, ""), "note": row.claim.note,
             })
     return pd.DataFrame(table)
+
+
+def _across(row: ClaimRow) -> dict:
+    """The multiverse's columns of ``claims.csv``: cases, the alternatives that flip the verdict, the
+    best case for the paper and its number (empty where the paper's multiverse was not run)."""
+    stored = row.multiverse or {}
+    best = stored.get("best_case") or {}
+    return {
+        "cases": len(stored.get("cases", [])) or None,
+        "flipped_by": "; ".join(f"{choice}={alternative} ({n} of {m})" for choice, alternative, n, m in
+                                stored.get("flips", [])),
+        "best_case": best.get("universe", "") and f"{best['universe']}, {dict(best['picks']).get('reading', '')}",
+        "best_case_verdict": (best.get("verdict") or {}).get("outcome", ""),
+        "best_case_number": (best.get("deciding") or {}).get("number", ""),
+        "multiverse": row.multiverse_experiment,
+    }

@@ -21,6 +21,9 @@ from matplotlib.colors import to_rgb
 ORANGE, SKY, GREEN, YELLOW = "#E69F00", "#56B4E9", "#009E73", "#F0E442"
 BLUE, VERMILLION, PURPLE, BLACK = "#0072B2", "#D55E00", "#CC79A7", "#000000"
 PALETTE = (ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILLION, PURPLE, BLACK)  # Okabe and Ito (2008)
+# a verdict's colour in figures, as on the report's pages (base.html.j2): keyed by Outcome's value
+OUTCOME_COLOURS = {"reproduced": "#1a7f37", "inconclusive": "#8a5a00", "not reproduced": "#b42318",
+                   "not testable": "#999999"}
 LINESTYLES = ("-", "--", "-.", ":")
 MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*", "<", ">", "h")
 

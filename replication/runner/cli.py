@@ -19,7 +19,7 @@ from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.runner.config import ConfigError, Run
 from replication.runner.execute import BackendError, execute
 from replication.runner.store import Store
-from replication.runner.validate import prepare
+from replication.runner.validate import parallel_settings, prepare
 
 
 def fail(message: str) -> None:
@@ -72,6 +72,8 @@ def interrupted(store: Store | None = None, runs: list[Run] | None = None) -> No
 
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
 def run_experiment(cfg: DictConfig) -> None:
+    if "multiverse" in cfg.experiment:
+        return run_multiverse(cfg)
     try:
         runs, skipped, (backend, n_jobs, address) = prepare(cfg)
     except ConfigError as error:
@@ -89,6 +91,37 @@ def run_experiment(cfg: DictConfig) -> None:
         written = write_experiment_report(cfg, runs, store)
         print(f"{cfg.experiment.name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
         run_companions(cfg)
+    except BackendError as error:
+        fail(str(error))
+    except KeyboardInterrupt:
+        interrupted(store, runs)
+
+
+def run_multiverse(cfg: DictConfig) -> None:
+    """Run every universe of a paper's multiverse (:mod:`replication.runner.multiverse`) into its base
+    experiments' stores, then write its report and the index."""
+    from replication.runner.multiverse import load
+
+    try:
+        multiverse = load(cfg)
+        backend, n_jobs, address = parallel_settings(cfg)
+    except ConfigError as error:
+        fail(str(error))
+    for message in multiverse.skipped:
+        print(f"skipped: {message}", file=sys.stderr)
+    name = cfg.experiment.name
+    print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices")
+    store, runs = None, None
+    try:
+        for experiment in multiverse.experiments:
+            store, runs = Store(resolve(cfg.store), experiment), multiverse.runs_of(experiment)
+            done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
+            print(f"{name}: {experiment}: {done} runs computed, {len(runs) - done} already stored")
+        from replication.report.index import write_index
+        from replication.report.multiverse import write_multiverse_report
+
+        written = write_multiverse_report(cfg, multiverse)
+        print(f"{name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
     except BackendError as error:
         fail(str(error))
     except KeyboardInterrupt:

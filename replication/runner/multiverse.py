@@ -1,0 +1,231 @@
+"""A paper's multiverse: its experiments re-run under every defensible reading of what it leaves open.
+
+``conf/experiment/<paper>_readings.yaml`` lists the paper's *choices* (a
+setting the paper does not state, or prints ambiguously), each with its
+*alternatives*: the config values it sets and the paper's words it rests on.
+The first alternative is the default: what the experiment configs say today.
+A *universe* picks one alternative per choice; the *design* says which
+universes are run: ``full`` (every combination), ``one_at_a_time`` (the
+default, then each other alternative alone) or ``{sobol: n}`` (n points of a
+scrambled Sobol sequence over the choices, for a product too large to run).
+
+Each universe's runs are the base experiments' runs with the alternatives'
+values set: they go through the same expansion, store (the base experiment's
+folder), seeds and backends as any run, and the run key hashes the changed
+config, so the default universe reuses the base experiments' stored runs and
+a run shared by several universes (a method no choice touches) is computed
+once.
+"""
+
+import copy
+import itertools
+import re
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from hydra import compose, initialize_config_dir
+from hydra.core.global_hydra import GlobalHydra
+from omegaconf import DictConfig, OmegaConf
+from scipy.stats import qmc
+
+from replication.paths import CONF_DIR, experiment_names
+from replication.runner.config import ConfigError, Run, at_scale
+from replication.runner.validate import prepare
+
+DESIGNS = ("full", "one_at_a_time", "sobol")
+NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class Alternative:
+    name: str
+    why: str
+    values: dict[str, Any]  # dotted path in an experiment config -> the value this reading gives it
+
+
+@dataclass(frozen=True)
+class Choice:
+    name: str
+    label: str
+    alternatives: tuple[Alternative, ...]
+
+    @property
+    def default(self) -> Alternative:
+        return self.alternatives[0]
+
+
+@dataclass(frozen=True)
+class Universe:
+    """One alternative per choice, by name; named after the alternatives that are not the default."""
+
+    picks: tuple[tuple[str, str], ...]  # (choice, alternative), in the choices' order
+    name: str
+
+    @classmethod
+    def of(cls, choices: tuple[Choice, ...], picked: list[Alternative]) -> "Universe":
+        changed = [f"{c.name}={a.name}" for c, a in zip(choices, picked) if a is not c.default]
+        return cls(tuple((c.name, a.name) for c, a in zip(choices, picked)), "; ".join(changed) or "default")
+
+    @property
+    def is_default(self) -> bool:
+        return self.name == "default"
+
+
+@dataclass(frozen=True)
+class Multiverse:
+    name: str
+    paper: str
+    experiments: tuple[str, ...]
+    choices: tuple[Choice, ...]
+    universes: tuple[Universe, ...]
+    runs: dict[tuple[str, str], list[Run]]  # (universe, experiment) -> its runs
+    experiment_configs: dict[tuple[str, str], dict]  # (universe, experiment) -> its config at the scale
+    skipped: tuple[str, ...] = ()  # conditions left out (a sequence not on this machine), once each
+
+    def runs_of(self, experiment: str) -> list[Run]:
+        """Every distinct run of ``experiment`` over the universes (a run several share, once)."""
+        distinct = {}
+        for (_, name), runs in self.runs.items():
+            if name == experiment:
+                distinct.update((run.run_id, run) for run in runs)
+        return list(distinct.values())
+
+
+def choices_of(spec: dict) -> tuple[Choice, ...]:
+    """The ``choices:`` block of a multiverse config, checked."""
+    if not isinstance(spec, dict) or not spec:
+        raise ConfigError("experiment.choices must map each choice's name to its label and alternatives")
+    found = []
+    for name, choice in spec.items():
+        where = f"experiment.choices.{name}"
+        if not NAME.fullmatch(str(name)):
+            raise ConfigError(f"{where}: a choice's name is lower-case letters, digits and _")
+        alternatives = (choice or {}).get("alternatives") if isinstance(choice, dict) else None
+        if not isinstance(alternatives, dict) or len(alternatives) < 2:
+            raise ConfigError(f"{where}.alternatives must map at least two alternatives to their why and set")
+        parsed = []
+        for alt, body in alternatives.items():
+            if not NAME.fullmatch(str(alt)) or not isinstance(body, dict):
+                raise ConfigError(f"{where}.alternatives.{alt}: a name (lower-case, digits, _) with why: and set:")
+            if not isinstance(body.get("why"), str) or not body["why"].strip():
+                raise ConfigError(f"{where}.alternatives.{alt}.why: say which words of the paper it rests on")
+            if not isinstance(body.get("set"), dict) or not body["set"]:
+                raise ConfigError(f"{where}.alternatives.{alt}.set must map config paths to values")
+            parsed.append(Alternative(str(alt), body["why"].strip(), dict(body["set"])))
+        found.append(Choice(str(name), str(choice.get("label", name)), tuple(parsed)))
+    return tuple(found)
+
+
+def design(choices: tuple[Choice, ...], spec: Any, seed: int) -> tuple[Universe, ...]:
+    """The universes to run, the default first (see the module's docstring for the designs)."""
+    sizes = [len(c.alternatives) for c in choices]
+    if spec == "full":
+        picks = itertools.product(*(range(n) for n in sizes))
+    elif spec == "one_at_a_time":
+        picks = [tuple(0 for _ in sizes)] + [tuple(i if j == k else 0 for j in range(len(sizes)))
+                                              for k, n in enumerate(sizes) for i in range(1, n)]
+    elif isinstance(spec, dict) and set(spec) == {"sobol"} and _power_of_two(spec["sobol"]):
+        points = qmc.Sobol(len(sizes), scramble=True, seed=np.random.default_rng(seed)).random(spec["sobol"])
+        drawn = (points * np.array(sizes)).astype(int)
+        picks = [tuple(0 for _ in sizes)] + [tuple(int(i) for i in row) for row in drawn]
+    else:
+        raise ConfigError(f"experiment.multiverse.design must be full, one_at_a_time or {{sobol: n}} with n a "
+                          f"power of two (Sobol points balance only then); got {spec!r}")
+    picks = list(dict.fromkeys(picks))  # the default once, a Sobol point drawn twice once
+    return tuple(Universe.of(choices, [c.alternatives[i] for c, i in zip(choices, p)]) for p in picks)
+
+
+def _power_of_two(n: Any) -> bool:
+    return isinstance(n, int) and not isinstance(n, bool) and n > 0 and n & (n - 1) == 0
+
+
+def matches(node: Any, path: str) -> list[tuple[Any, Any]]:
+    """The (container, key) pairs a dotted ``path`` reaches in ``node``; ``*`` matches every key and an
+    integer indexes a list.  Only paths that exist to their last key match: an override never adds a key."""
+    head, _, rest = path.partition(".")
+    if isinstance(node, dict):
+        keys = list(node) if head == "*" else [head] if head in node else []
+    elif isinstance(node, list):
+        keys = list(range(len(node))) if head == "*" else [int(head)] if head.isdigit() and int(head) < len(node) else []
+    else:
+        keys = []
+    if not rest:
+        return [(node, key) for key in keys]
+    return [found for key in keys for found in matches(node[key], rest)]
+
+
+def apply(experiment: dict, values: dict[str, Any]) -> tuple[dict, list[str]]:
+    """``experiment`` with each path of ``values`` set where it exists, and the paths that matched."""
+    changed = copy.deepcopy(experiment)
+    matched = []
+    for path, value in values.items():
+        places = matches(changed, path)
+        for container, key in places:
+            container[key] = copy.deepcopy(value)
+        if places:
+            matched.append(path)
+    return changed, matched
+
+
+def load(cfg: DictConfig) -> Multiverse:
+    """The multiverse ``cfg.experiment`` describes: its choices checked against its base experiments
+    (every alternative sets something; the default's values are the configs' own), its universes, and
+    every universe's runs, validated as the base experiments' runs are."""
+    exp = cfg.experiment
+    spec = at_scale(OmegaConf.to_container(exp.multiverse, resolve=True), cfg.scale)
+    choices = choices_of(OmegaConf.to_container(exp.choices, resolve=True) if "choices" in exp else {})
+    experiments = tuple(spec.get("experiments") or ())
+    runs_per_universe = spec.get("runs")
+    if not experiments:
+        raise ConfigError("experiment.multiverse.experiments must list the experiments whose claims it re-tests")
+    if not isinstance(runs_per_universe, int) or runs_per_universe <= 0:
+        raise ConfigError(f"experiment.multiverse.runs.{cfg.scale} must be a positive integer, got {runs_per_universe!r}")
+    unknown = sorted(set(experiments) - set(experiment_names()))
+    if unknown:
+        raise ConfigError(f"experiment.multiverse.experiments: no experiment {unknown[0]!r}")
+    bases = {name: _experiment(name) for name in experiments}
+    _check_choices(choices, bases, cfg.scale)
+    universes = design(choices, spec.get("design", "full"), int(cfg.base_seed))
+    top = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items() if k != "experiment"}
+    runs, configs, skipped = {}, {}, {}
+    for universe in universes:
+        picked = dict(universe.picks)
+        values = {path: value for c in choices for a in c.alternatives if a.name == picked[c.name]
+                  for path, value in a.values.items()}
+        for name, base in bases.items():
+            experiment, _ = apply(base, values)
+            experiment["runs"] = {scale: runs_per_universe for scale in ("paper", "quick")}
+            derived = OmegaConf.create({**top, "experiment": experiment})
+            try:
+                runs[universe.name, name], missing, _ = prepare(derived)
+            except ConfigError as error:
+                raise ConfigError(f"{exp.name}, universe {universe.name}, {name}: {error}") from None
+            skipped.update(dict.fromkeys(missing))
+            configs[universe.name, name] = at_scale(experiment, cfg.scale)
+    return Multiverse(exp.name, exp.paper, experiments, choices, universes, runs, configs, tuple(skipped))
+
+
+def _experiment(name: str) -> dict:
+    """Experiment ``name``'s config as Hydra composes it (with what it inherits through ``defaults:``)."""
+    if not GlobalHydra.instance().is_initialized():  # outside a Hydra app (the report, a test)
+        with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+            return _experiment(name)
+    return OmegaConf.to_container(compose("config", overrides=[f"experiment={name}"]).experiment, resolve=True)
+
+
+def _check_choices(choices: tuple[Choice, ...], bases: dict[str, dict], scale: str) -> None:
+    """Every alternative's every path exists in some base experiment, and the default's values are the
+    configs' own (so the default universe is the experiments as they stand)."""
+    for choice in choices:
+        for alternative in choice.alternatives:
+            for path, value in alternative.values.items():
+                places = [(name, container[key]) for name, base in bases.items()
+                          for container, key in matches(base, path)]
+                where = f"experiment.choices.{choice.name}.alternatives.{alternative.name}.set.{path}"
+                if not places:
+                    raise ConfigError(f"{where}: no such key in {', '.join(bases)} (write the default there first)")
+                if alternative is choice.default:
+                    differing = [name for name, found in places if at_scale(found, scale) != at_scale(value, scale)]
+                    if differing:
+                        raise ConfigError(f"{where}: the default alternative must be what {differing[0]} says today")

@@ -1,0 +1,168 @@
+"""A paper's multiverse: designs over its open choices, overrides that only touch what exists, the
+default universe equal to the experiments as they stand, and each claim's robustness across cases."""
+
+import pytest
+from hydra import compose, initialize_config_dir
+from omegaconf import OmegaConf
+
+from replication.paths import CONF_DIR, experiment_names
+from replication.report.claims import Claim, Reading, load_papers
+from replication.report.multiverse import READING, Case, Robustness, write_multiverse_report
+from replication.report.verdict import Outcome, Verdict
+from replication.runner.config import ConfigError, expand
+from replication.runner.execute import execute
+from replication.runner.multiverse import apply, choices_of, design, load, matches
+from replication.runner.store import Store
+
+TWO_BY_THREE = {
+    "a": {"label": "first", "alternatives": {"a0": {"why": "x", "set": {"p": 0}}, "a1": {"why": "y", "set": {"p": 1}}}},
+    "b": {"label": "second", "alternatives": {f"b{i}": {"why": "z", "set": {"q": i}} for i in range(3)}},
+}
+
+
+def test_designs_start_from_the_default_and_cover_what_they_say():
+    choices = choices_of(TWO_BY_THREE)
+    full = design(choices, "full", seed=1)
+    assert len(full) == 6 and full[0].is_default and len({u.name for u in full}) == 6
+    assert [u.name for u in design(choices, "one_at_a_time", seed=1)] == ["default", "a=a1", "b=b1", "b=b2"]
+    sobol = design(choices, {"sobol": 8}, seed=1)
+    assert sobol[0].is_default and set(sobol) <= set(full)
+    assert design(choices, {"sobol": 8}, seed=1) == sobol  # seeded
+    for bad in ("all", {"sobol": 6}, {"lhs": 4}):
+        with pytest.raises(ConfigError, match="design"):
+            design(choices, bad, seed=1)
+
+
+def test_a_choice_needs_two_alternatives_each_with_its_why():
+    with pytest.raises(ConfigError, match="at least two"):
+        choices_of({"a": {"alternatives": {"only": {"why": "x", "set": {"p": 0}}}}})
+    with pytest.raises(ConfigError, match="why"):
+        choices_of({"a": {"alternatives": {"a0": {"set": {"p": 0}}, "a1": {"why": "y", "set": {"p": 1}}}}})
+
+
+def test_an_override_touches_only_paths_that_exist():
+    config = {"methods": {"ISM": {"bests": "stored", "c1": 0.8}, "PF": {"n": 10}},
+              "scenes": {"s": {"targets": [{"v": 1}, {"v": 2}]}}}
+    assert [key for _, key in matches(config, "methods.*.bests")] == ["bests"]
+    assert len(matches(config, "scenes.s.targets.*.v")) == 2 and matches(config, "scenes.s.targets.5.v") == []
+    changed, matched = apply(config, {"methods.*.bests": "rescored", "methods.*.absent": 1,
+                                      "scenes.s.targets.1.v": 9})
+    assert changed["methods"]["ISM"]["bests"] == "rescored" and "bests" not in changed["methods"]["PF"]
+    assert changed["scenes"]["s"]["targets"] == [{"v": 1}, {"v": 9}]
+    assert matched == ["methods.*.bests", "scenes.s.targets.1.v"]
+    assert config["methods"]["ISM"]["bests"] == "stored"  # the original is left as it was
+
+
+def _multiverse_cfg(tmp_path, choices: dict, design_spec="full"):
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=["experiment=hspf_ungm", "scale=quick", f"store={tmp_path}/store",
+                                           f"reports={tmp_path}/reports", "progress=false"])
+    top = OmegaConf.to_container(cfg, resolve=True)
+    top["experiment"] = {"name": "hspf_test_readings", "paper": "hspf", "title": "test",
+                         "multiverse": {"experiments": ["hspf_ungm"], "runs": {"paper": 5, "quick": 5},
+                                        "design": design_spec},
+                         "choices": choices}
+    return OmegaConf.create(top)
+
+
+HMS = {"hms": {"label": "harmony memory size", "alternatives": {
+    "paper": {"why": "HMS = 2, section 4.1", "set": {"methods.HSPF.hms": 2}},
+    "larger": {"why": "a larger memory", "set": {"methods.HSPF.hms": 4}}}}}
+
+
+def test_the_default_must_be_the_config_as_it_stands_and_every_path_must_exist(tmp_path):
+    wrong_default = {"hms": {"alternatives": {"a": {"why": "x", "set": {"methods.HSPF.hms": 3}},
+                                              "b": {"why": "y", "set": {"methods.HSPF.hms": 4}}}}}
+    with pytest.raises(ConfigError, match="default alternative must be what hspf_ungm says today"):
+        load(_multiverse_cfg(tmp_path, wrong_default))
+    absent = {"hms": {"alternatives": {"a": {"why": "x", "set": {"methods.HSPF.nope": 3}},
+                                       "b": {"why": "y", "set": {"methods.HSPF.nope": 4}}}}}
+    with pytest.raises(ConfigError, match="no such key"):
+        load(_multiverse_cfg(tmp_path, absent))
+
+
+def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_universe(tmp_path):
+    cfg = _multiverse_cfg(tmp_path, HMS)
+    multiverse = load(cfg)
+    assert [u.name for u in multiverse.universes] == ["default", "hms=larger"]
+    default = {r.run_id for r in multiverse.runs["default", "hspf_ungm"]}
+    larger = {r.run_id for r in multiverse.runs["hms=larger", "hspf_ungm"]}
+    assert len(default) == len(larger) == 3 * 5  # PF, HSPF and the grid, 5 runs each
+    # PF and the grid are the same in both universes (one run each), HSPF differs
+    assert {i.split("__")[0] for i in default ^ larger} == {"HSPF"} and len(default & larger) == 10
+    assert len(multiverse.runs_of("hspf_ungm")) == 20
+    # the default universe's runs are the base experiment's own first runs: stored once, used by both
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        base = expand(compose("config", overrides=["experiment=hspf_ungm", "scale=quick"]))
+    assert default <= {r.run_id for r in base}
+    store = Store(tmp_path / "store", "hspf_ungm")
+    assert execute(multiverse.runs_of("hspf_ungm"), store, n_jobs=1, backend="threading", progress=False) == 20
+    page = write_multiverse_report(cfg, multiverse)
+    summary = OmegaConf.to_container(OmegaConf.load(page.parent / "summary.json"))
+    claim = summary["multiverse"]["hspf.ungm"]
+    readings = [r.name for p in load_papers() for c in p.claims if c.id == "hspf.ungm" for r in c.readings]
+    assert len(claim["cases"]) == 2 * len(readings)  # every universe with every reading of the claim
+    assert {tuple(p) for case in claim["cases"] for p in case["picks"]} >= {("hms", "paper"), ("hms", "larger")}
+    assert (page.parent / "readings.png").exists() and (page.parent / "cases.csv").exists()
+
+
+def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", held: int = 1) -> Case:
+    checks = tuple({"verdict": {"outcome": Outcome.REPRODUCED.value if i < held else outcome.value}}
+                   for i in range(2))
+    return Case(universe, (*picks.items(), (READING, reading)), Verdict(outcome),
+                {"what": "A - B", "number": universe, "value": 1.0}, checks)
+
+
+CLAIM = Claim("p.c", "p", "A beats B", "Table 1", {}, (Reading("r1", "e", {}),))
+
+
+def test_robust_when_every_testable_case_agrees():
+    cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED), _case("x=b", {"x": "b"}, Outcome.NOT_REPRODUCED),
+             _case("x=c", {"x": "c"}, Outcome.NOT_TESTABLE))
+    robustness = Robustness(CLAIM, cases)
+    assert robustness.robust is True and robustness.flips == []
+    assert robustness.summary == "robust: not reproduced in all 2 cases"
+
+
+def test_a_flip_names_the_alternative_and_the_best_case_for_the_paper():
+    cases = (_case("default", {"x": "a", "y": "a"}, Outcome.NOT_REPRODUCED),
+             _case("x=b", {"x": "b", "y": "a"}, Outcome.REPRODUCED),
+             _case("y=b", {"x": "a", "y": "b"}, Outcome.INCONCLUSIVE, held=0),
+             _case("y=b'", {"x": "a", "y": "b"}, Outcome.INCONCLUSIVE, reading="r2", held=1))
+    robustness = Robustness(CLAIM, cases)
+    assert robustness.robust is False
+    assert robustness.flips == [("x", "b", 1, 1), ("y", "b", 2, 2), (READING, "r2", 1, 1)]
+    assert robustness.best_case.universe == "x=b"
+    assert "flipped under x=b (1 of 1)" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
+    # between two inconclusive cases the one with more checks holding is closer
+    assert Robustness(CLAIM, cases[2:]).best_case.universe == "y=b'"
+
+
+def test_every_multiverse_config_loads_with_its_defaults_equal_to_the_experiments(tmp_path):
+    names = [n for n in experiment_names() if n.endswith("_readings")]
+    for name in names:
+        with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+            cfg = compose("config", overrides=[f"experiment={name}", "scale=quick"])
+        multiverse = load(cfg)
+        assert multiverse.universes[0].is_default and len(multiverse.universes) > 1, name
+        for choice in multiverse.choices:
+            assert all(a.why for a in choice.alternatives), (name, choice.name)
+
+
+def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiverse():
+    import pandas as pd
+
+    from replication.report.scorecard import claim_rows, claims_frame
+
+    papers = [p for p in load_papers() if p.key == "hspf"]
+    cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED), _case("x=b", {"x": "b"}, Outcome.REPRODUCED))
+    stored = Robustness(papers[0].claims[0], cases).as_dict()
+    rows = claim_rows(papers, {"hspf_readings": {"multiverse": {papers[0].claims[0].id: stored}}})
+    first, second = rows["hspf"][:2]
+    assert first.robust is False and first.robustness.startswith("depends on the reading")
+    assert second.multiverse is None and second.robust is None
+    frame = claims_frame(rows, pd.DataFrame({"claim": []}), {})
+    row = frame.iloc[0]
+    assert not row["robust"] and row["robust"] is not None
+    assert row["flipped_by"] == "x=b (1 of 1)" and row["best_case"] == "x=b, r1"
+    assert row["best_case_verdict"] == "reproduced" and row["cases"] == 2 and row["multiverse"] == "hspf_readings"
