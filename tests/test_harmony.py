@@ -71,6 +71,9 @@ def test_bandwidth_decays_exponentially_from_max_to_min():
         (lambda: HarmonyMove(idle=0), "idle \\(ider\\)"),
         (lambda: HarmonyMove(precision=0.0), "precision \\(Tprecision\\)"),
         (lambda: HarmonyMove(quality=-0.7), "quality \\(Tquality\\) is a likelihood"),
+        (lambda: HarmonyMove(quality_units="ncc"), "unknown quality_units 'ncc'; choose one of"),
+        (lambda: HarmonyMove(quality=1.5, quality_units="rho"), "in rho units must lie in \\[0, 1\\]"),
+        (lambda: HarmonyMove(likelihood_sigma=0.0), "likelihood_sigma must be positive"),
         (lambda: HarmonyMove(compensation="magic"), "unknown compensation"),
         (lambda: log_compensation(np.zeros(2), np.zeros(2), "magic"), "unknown compensation"),
     ],
@@ -112,6 +115,22 @@ def test_quality_stops_the_search_in_likelihood_units():
     flat = HarmonyMove(ni=10, radius=1.0, idle=None, precision=None, quality=0.7)
     at_start = flat.search(particles, lambda x: np.full(len(x), np.log(0.8)), rng)  # f = 0.8 >= 0.7 already
     np.testing.assert_array_equal(at_start.iterations, 0)
+
+
+def test_quality_in_rho_units_is_a_bhattacharyya_threshold():
+    # rho >= 0.7 with sigma = 0.1: log p >= -0.3 / 0.02 - log(sqrt(2 pi) 0.1) = -15 + 1.383647 = -13.616353
+    move = HarmonyMove(ni=10, radius=1.0, idle=None, precision=None, quality=0.7, quality_units="rho")
+    assert move.log_quality == pytest.approx(-13.616353, abs=1e-6)
+    particles, rng = particles_and_rng()
+
+    def at_rho(rho):  # the colour likelihood of a box whose Bhattacharyya coefficient is rho, everywhere
+        return lambda x: np.full(len(x), -(1.0 - rho) / (2.0 * 0.1**2) - np.log(np.sqrt(2.0 * np.pi) * 0.1))
+
+    np.testing.assert_array_equal(move.search(particles, at_rho(0.75), rng).iterations, 0)
+    np.testing.assert_array_equal(move.search(particles, at_rho(0.65), rng).iterations, 10)
+    in_likelihood = HarmonyMove(ni=10, radius=1.0, idle=None, precision=None, quality=0.7)
+    np.testing.assert_array_equal(in_likelihood.search(particles, at_rho(0.75), rng).iterations, 10)
+    np.testing.assert_array_equal(in_likelihood.search(particles, at_rho(0.97), rng).iterations, 0)
 
 
 def test_precision_stops_the_search_once_worst_and_best_meet():

@@ -10,12 +10,14 @@ particle moves to its best harmony.  Its weight is then compensated by lambda
 What the paper leaves open, and our reading:
 
 * fitness: log p(z | x), the log of the paper's objective f = p(Z | X); the
-  log changes no comparison.  ``quality`` (Tquality) is therefore in
-  *likelihood* units: a particle stops once its best harmony has
-  p(z | x) >= quality.  For the colour likelihood with sigma, a Bhattacharyya
-  threshold rho_th is quality = exp(-(1 - rho_th) / (2 sigma^2)) / (sqrt(2 pi) sigma)
-  (0.7 with sigma = 0.1 means rho >= 0.965); on the UNGM with R = 1 the
-  likelihood never exceeds 0.399, so 0.7 never fires there.
+  log changes no comparison.  The units of ``quality`` (Tquality = 0.7) are
+  not stated: ``quality_units="likelihood"`` (our default) stops a particle
+  once its best harmony has p(z | x) >= quality; ``"rho"`` reads it as
+  Fourie et al.'s Bhattacharyya threshold rho >= quality, i.e. p(z | x) >=
+  exp(-(1 - rho_th) / (2 sigma^2)) / (sqrt(2 pi) sigma) for the colour
+  likelihood with ``likelihood_sigma``.  With sigma = 0.1, 0.7 in likelihood
+  units means rho >= 0.965; on the UNGM with R = 1 the likelihood never
+  exceeds 0.399, so 0.7 never fires there.
 * window: ``radius`` per coordinate (a scalar applies to all); the default
   (8, 8, 1, 1) px is twice the box random walk's ``step_sd``.
 * initial memory (Step 2): the predicted particle plus HMS - 1 uniform draws
@@ -33,12 +35,21 @@ What the paper leaves open, and our reading:
 * compensation: eqs (2)-(3) read as printed (``"printed"``) give
   lambda^i = p(X^i) / q(X~^i), the mixture of the moved particles at the
   moved particle over the mixture of the predicted particles at the
-  predicted particle.  ``"importance"`` reads them as the importance ratio
-  of MSEPF (Shan et al. 2007): the prior predictive mixture centred on the
-  predicted particles over the proposal mixture centred on the moved ones,
-  both at the moved particle.  Each mixture's Gaussians have the diagonal
-  variance of the particle set they are centred on ("Sigma is the variance
-  of the particle set").  ``"none"`` ignores the move (the HS tracker).
+  predicted particle.  ``"importance"`` is the correction eq (1) aims at
+  ("so that the new particle set and the set before the move follow the
+  same distribution"): X^i is a draw from the proposal q (prior
+  prediction, then the HS move), whose density is intractable, and the
+  target is p(z | x) pi(x) with pi the prior prediction, so the importance
+  weight is pi(X^i) / q(X^i) p(z | X^i).  The mixtures of eqs (2)-(3) are
+  kernel estimates of pi (centred on the predicted particles, draws from
+  pi) and of q (centred on the moved ones, draws from q), both evaluated at
+  the moved particle, as in MSEPF (Shan et al. 2007).  As printed, eq (1)
+  puts the moved set's density on top and evaluates the predicted set's at
+  the unmoved particle, which inverts the ratio.  A move that leaves every
+  particle in place gives lambda = 1 under both.  Each mixture's Gaussians
+  have the diagonal variance of the particle set they are centred on
+  ("Sigma is the variance of the particle set").  ``"none"`` ignores the
+  move (the HS tracker).
 """
 
 from dataclasses import dataclass
@@ -47,8 +58,10 @@ import numpy as np
 
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 from replication.smc.weights import logsumexp
+from replication.vision.likelihood import gaussian_similarity_log_likelihood
 
 COMPENSATIONS = ("printed", "importance", "none")
+QUALITY_UNITS = ("likelihood", "rho")
 MIN_VARIANCE = 1e-12  # keeps G defined when a particle set has no spread in a coordinate
 
 
@@ -139,7 +152,9 @@ class HarmonyMove:
     radius: float | tuple[float, ...] = (8.0, 8.0, 1.0, 1.0)
     idle: int | None = 5
     precision: float | None = 5.0
-    quality: float | None = 0.7  # likelihood units
+    quality: float | None = 0.7  # Tquality, in quality_units
+    quality_units: str = "likelihood"  # or "rho": the Bhattacharyya coefficient (see the module notes)
+    likelihood_sigma: float = 0.1  # the colour likelihood's sigma: turns a Tquality in rho into p(z | x)
     compensation: str = "printed"
 
     def __post_init__(self):
@@ -160,10 +175,18 @@ class HarmonyMove:
             raise ValueError(f"idle (ider) must be a positive integer or None, got {self.idle}")
         if self.precision is not None and self.precision <= 0:
             raise ValueError(f"precision (Tprecision) must be positive or None, got {self.precision}")
-        if self.quality is not None and self.quality <= 0:
+        if self.quality_units not in QUALITY_UNITS:
+            raise ValueError(f"unknown quality_units {self.quality_units!r}; choose one of {QUALITY_UNITS}")
+        if self.quality is not None and self.quality_units == "likelihood" and self.quality <= 0:
             raise ValueError(
                 f"quality (Tquality) is a likelihood and must be positive or None, got {self.quality}"
             )
+        if self.quality is not None and self.quality_units == "rho" and not 0.0 <= self.quality <= 1.0:
+            raise ValueError(
+                f"quality (Tquality) in rho units must lie in [0, 1] or be None, got {self.quality}"
+            )
+        if not self.likelihood_sigma > 0:
+            raise ValueError(f"likelihood_sigma must be positive, got {self.likelihood_sigma}")
         if self.compensation not in COMPENSATIONS:
             raise ValueError(f"unknown compensation {self.compensation!r}; choose one of {COMPENSATIONS}")
 
@@ -178,8 +201,15 @@ class HarmonyMove:
             worst = harmony_memory[rows, fitness.argmin(axis=1)]
             stop |= np.linalg.norm(best - worst, axis=-1) < self.precision
         if self.quality is not None:
-            stop |= fitness.max(axis=1) >= np.log(self.quality)
+            stop |= fitness.max(axis=1) >= self.log_quality
         return stop
+
+    @property
+    def log_quality(self) -> float:
+        """Tquality as a log-likelihood, the fitness's units."""
+        if self.quality_units == "rho":
+            return float(gaussian_similarity_log_likelihood(self.quality, self.likelihood_sigma))
+        return float(np.log(self.quality))
 
     def search(self, particles, log_likelihood, rng) -> HarmonySearch:
         """Run IHS (Steps 2-5) from every particle at once, each in its window, each with its own stop."""
