@@ -75,3 +75,23 @@ def test_a_method_observation_block_overrides_the_model_observation(make_cfg):
     assert observation["color+structure fusion PF"]["adaptive"] is True
     assert observation["fusion-sigma-0.1"]["sigma"] == 0.1 and observation["color-only PF"]["sigma"] == 1.0
     assert len({r.key for r in runs if r.condition == "scene=airplane"}) == 4
+
+
+def test_a_turning_plane_moves_alpha_towards_colour():
+    """Eqs (6)-(7) on the airplane stand-in's sprite: on frame 0 rho' = S' = 1 gives alpha = 1/2; once the
+    plane has turned 30 degrees its structure no longer matches the template, so S' < rho' and alpha > 1/2."""
+    from replication.scenes import SyntheticScene
+
+    plane = {"shape": "box", "size": [40, 24], "colour": [90, 110, 140], "colour_spread": 10, "structure": True,
+             "motion": {"kind": "scripted", "keyframes": [[0, 60, 40]]}, "rotation": [[0, 0.0], [1, 30.0]]}
+    scene = SyntheticScene({"size": [120, 80], "frames": 2, "background": {"kind": "flat", "colour": [170, 150, 130]},
+                            "targets": [plane]})
+    box = np.array([60.0, 40.0, 40.0, 24.0])
+    histogram = ColourHistogram(bins=(8, 8, 2), kernel="diagonal", grid=(24, 16))
+    model = FusionLikelihood.from_frame(scene.frame(0), box, histogram, square=20)
+    model.adapt(box, model.prepare(scene.frame(0)))
+    assert model.alpha == pytest.approx(0.5)
+    rho, s, _ = model.similarities(box[None], model.prepare(scene.frame(1)))
+    assert s[0] < 0.8 < rho[0]
+    model.adapt(box, model.prepare(scene.frame(1)))
+    assert model.alpha > 0.55 and model.history == [pytest.approx(0.5), model.alpha]
