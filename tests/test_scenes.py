@@ -189,3 +189,36 @@ def test_scene_writer_command(tmp_path):
         [sys.executable, "-m", "replication.scenes", "experiment=hspf_ungm"], cwd=PROJECT_ROOT, capture_output=True, text=True
     )
     assert refused.returncode == 2 and "no synthetic scene" in refused.stderr
+
+
+def _3123(hidden_motion):
+    from omegaconf import OmegaConf
+
+    from replication.paths import CONF_DIR
+    from replication.runner.config import at_scale
+    from replication.scenes.factory import build_sequence
+
+    experiment = OmegaConf.to_container(OmegaConf.load(CONF_DIR / "experiment" / "bis_pf.yaml"))
+    return build_sequence({**at_scale(experiment["scenes"]["exp1_3123"], "paper"), "hidden_motion": hidden_motion})
+
+
+def test_3123_hidden_targets_move_with_1_or_keep_their_own_velocity():
+    """bis_pf's 3123 script, two readings: 2 (hidden 51-70) and 3 (hidden 51-93) move exactly with 1 while
+    hidden, or keep one velocity of their own; either way 2 goes in from above and out below, 3 the reverse."""
+    with_1, own = _3123("with_occluder"), _3123("own_velocity")
+    one = with_1.objects[0].centres
+    for target, (first, last) in ((1, (51, 70)), (2, (51, 93))):
+        np.testing.assert_allclose(with_1.objects[target].centres[first : last + 1], one[first : last + 1], atol=1e-3)
+        path = own.objects[target].centres
+        np.testing.assert_allclose(np.diff(path, 2, axis=0), 0, atol=1e-9)  # one velocity throughout
+        relative = path - one
+        mid = (first + last) // 2  # through 1's centre midway, half covered (0.404 x 18 px) at the ends
+        assert np.hypot(*relative[mid]) < np.hypot(*(relative[mid + 1] - relative[mid]))
+        np.testing.assert_allclose(np.hypot(*relative[first]), 0.404 * 18, rtol=0.03)
+        hidden = np.flatnonzero(own.visibility[:, target] < 0.5)
+        assert abs(hidden[0] - first) <= 1 and abs(hidden[-1] - last) <= 1 and len(hidden) == hidden[-1] - hidden[0] + 1
+        for scene in (with_1, own):
+            side = np.sign(scene.objects[target].centres[[0, -1], 1] - one[[0, -1], 1])
+            assert list(side) == ([-1, 1] if target == 1 else [1, -1])  # y grows downwards
+    with pytest.raises(SceneError, match="hidden_motion"):
+        _3123("bounce")

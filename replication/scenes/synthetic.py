@@ -35,6 +35,12 @@ Motion kinds: ``scripted`` (linear between keyframes [frame, cx, cy]),
 ``noise_var`` per frame, speed capped at ``max_speed``, bouncing off the
 borders: the bis_pf tennis balls).
 
+A scripted target hidden behind another may say so: ``hidden: {behind: 0,
+frames: [51, 70]}``.  The scene's ``hidden_motion`` then reads its script:
+``with_occluder`` (the default) follows the keyframes, which move it exactly
+with the occluder while hidden (bis_pf's 3123 stand-in); ``own_velocity``
+keeps its own velocity instead (:func:`own_velocity_path`).
+
 Camera noise is i.i.d. Gaussian per pixel within a frame; to keep rendering
 cheap, frame k reads it from one stored noise bank at an offset drawn from
 (seed, k), so frames are reproducible in any order.
@@ -53,6 +59,8 @@ import numpy as np
 SHAPES = ("ellipse", "box", "ball", "head")
 BACKGROUNDS = ("flat", "gradient", "noise", "clutter")
 MOTIONS = ("scripted", "velocity", "random_walk")
+HIDDEN_MOTIONS = ("with_occluder", "own_velocity")
+HALF_COVERED = 0.404  # centre distance / diameter at which a disc behind an equal disc is half covered
 NOISE_OFFSETS = 1 << 16
 
 
@@ -104,6 +112,20 @@ def trajectory(motion: dict, n_frames: int, size: tuple[int, int], rng: np.rando
                 velocity[axis] = -velocity[axis]
                 centre[axis] = np.clip(centre[axis], low[axis], high[axis])
     return path
+
+
+def own_velocity_path(path: np.ndarray, occluder: np.ndarray, frames, diameter: float) -> np.ndarray:
+    """A hidden target that keeps its own velocity: a straight line relative to the ``occluder``'s path,
+    in the direction the target's ``path`` comes in at ``frames[0]``, through the occluder's centre midway,
+    at the speed that keeps it at least half covered over ``frames`` (bis_pf 3123: 2 hidden 51-70, 3 51-93).
+    Behind an occluder in uniform motion it is a uniform motion of its own."""
+    first, last = frames
+    _require(0 < first < last < len(path), f"hidden frames {list(frames)} must lie inside the scene, first < last")
+    relative = path - occluder
+    direction = relative[first] - relative[first - 1]
+    _require(np.hypot(*direction) > 0, "a hidden target must be moving against its occluder when it goes in")
+    speed = 2 * HALF_COVERED * diameter / (last - first)
+    return occluder + np.outer(np.arange(len(path)) - (first + last) / 2, speed * direction / np.hypot(*direction))
 
 
 def _textured(colour, spread: float, shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
@@ -216,6 +238,13 @@ class SyntheticScene:
         rng = np.random.default_rng(self.seed)
         self.background = self._background(spec.get("background", {"kind": "flat"}), rng)
         self.objects = [self._object(t, i, rng) for i, t in enumerate(spec["targets"])]
+        hidden_motion = spec.get("hidden_motion", "with_occluder")
+        _require(hidden_motion in HIDDEN_MOTIONS, f"unknown hidden_motion {hidden_motion!r}; choose one of {HIDDEN_MOTIONS}")
+        for obj in self.objects:
+            hidden = obj.spec.get("motion", {}).get("hidden")
+            if hidden and hidden_motion == "own_velocity":
+                drawn = 2 * (min(obj.spec["size"]) // 2 - 1)  # the disc sprite() draws
+                obj.centres = own_velocity_path(obj.centres, self.objects[hidden["behind"]].centres, hidden["frames"], drawn)
         self.objects += [self._object(o, None, rng) for o in spec.get("occluders", [])]
         self.order = sorted(range(len(self.objects)), key=lambda i: -self.objects[i].depth)  # far to near
         frames = np.arange(self.n_frames)
