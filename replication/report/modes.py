@@ -9,12 +9,14 @@ counts as two-mode when at least ``mass`` of the marginal lies within
 hypotheses are more than 2 ``width`` apart (before that they are one mode).
 A run keeps both modes when most of those frames do; a method does when
 most of its runs do (the table kind ``modes`` in :mod:`replication.report.tables`).
+The hypotheses come from the video each run saw (its ``scene_seed``).
 """
 
 import numpy as np
 import pandas as pd
 
-from replication.report.tracking_figures import _sequence
+from replication.report.tracking_figures import _scene_name
+from replication.scenes.factory import cached_sequence
 
 
 def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, width: float, mass: float) -> float:
@@ -34,11 +36,14 @@ def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
-    sequence, _ = _sequence(experiment, group)
-    axis = "xy".index(group["strip"].iloc[0]["axis"])
-    truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
-    hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
-    return np.array([
-        two_mode_share(np.asarray(s["density"])[first - 1 : last], hypotheses, sequence.size[axis], width, mass)
-        for s in group["strip"]
-    ])
+    scene = experiment["scenes"][_scene_name(experiment, group["condition"].iloc[0])]
+    shares = []
+    for _, run in group.iterrows():
+        seed = run.get("scene_seed")
+        sequence = cached_sequence(scene if seed is None or pd.isna(seed) else {**scene, "seed": int(seed)})
+        axis = "xy".index(run["strip"]["axis"])
+        truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
+        hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
+        density = np.asarray(run["strip"]["density"])[first - 1 : last]
+        shares.append(two_mode_share(density, hypotheses, sequence.size[axis], width, mass))
+    return np.array(shares)

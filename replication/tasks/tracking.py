@@ -3,7 +3,9 @@
 The first frame's true box initialises each filter and its reference
 histogram (the OTB one-pass protocol); frames 1..T-1 are filtered, every
 target's filter stepping through a frame before the next frame is produced,
-so the frame's features are computed once for all targets.  Timings are per
+so the frame's features are computed once for all targets.  A synthetic
+scene's ``scene_seed`` says whether every run sees the configured video
+(``fixed``) or the repetition draws its own (``per_run``).  Timings are per
 frame for all targets together and exclude producing the frame (rendering or
 JPEG decoding), which the papers' videos did not pay for.
 """
@@ -24,6 +26,7 @@ from replication.vision.histogram import ColourHistogram
 
 OBSERVATIONS = ("colour", "fusion")  # kernel colour histogram; colour + structure (fusion_pf)
 FUSION_KEYS = ("square", "alpha", "adaptive")
+SCENE_SEEDS = ("fixed", "per_run")
 
 
 def targets(model: dict, n_targets: int) -> list[int]:
@@ -33,9 +36,21 @@ def targets(model: dict, n_targets: int) -> list[int]:
     return list(range(n_targets)) if chosen == "all" else list(chosen)
 
 
+def scene_spec(run: Run) -> dict:
+    """The run's scene: as configured (``scene_seed: fixed``: every run sees the same video), or seeded
+    from the repetition's data stream (``per_run``: bis_pf 3.2 generates its videos "on the fly"), which
+    every method at that repetition shares (common random numbers)."""
+    spec = run.model["scene_spec"]
+    if spec.get("scene_seed", "fixed") == "fixed":
+        return spec
+    return {**spec, "seed": int(run.rng("data").integers(2**31))}
+
+
 def check(model: dict, method: dict) -> None:
     if "scene_spec" not in model:
         raise ValueError("a tracking experiment needs model.scene naming one of experiment.scenes")
+    if model["scene_spec"].get("scene_seed", "fixed") not in SCENE_SEEDS:
+        raise ValueError(f"unknown scene_seed {model['scene_spec']['scene_seed']!r}; choose one of {SCENE_SEEDS}")
     observation = model.get("observation", {})
     if observation.get("kind", "colour") not in OBSERVATIONS:
         raise ValueError(f"unknown observation {observation.get('kind')!r}; choose one of {OBSERVATIONS}")
@@ -75,14 +90,17 @@ def build_model(run: Run, sequence, target: int, cache: dict) -> BoxModel:
     return BoxModel(initial, likelihood, cache=cache, first_frame=first, **run.model.get("motion", {}))
 
 
-def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarray, visibility: np.ndarray) -> dict:
+def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarray, visibility: np.ndarray,
+                        chosen: list[int]) -> dict:
     """bis_pf's numbers: mean error per target (px), targets lost, identity switches, and failure.
 
     A target is lost when its estimate stays more than ``loss_threshold`` px
     from its own truth for ``loss_patience`` frames in a row while at least half
     of it is visible, from frame ``from_frame`` on (1-based; the 3123 test judges
     only after target 3 reappears).  A swap loses both targets.  A run fails
-    when any target is lost.
+    when any target is lost (``failed``); with ``key_target`` (a scene target,
+    0-based) it also says whether that one is (``failed[target<k + 1>]``: the
+    3123 test's success is target 3 picked up again, section 3.1).
     """
     threshold = evaluation.get("loss_threshold", 20.0)
     start = max(int(evaluation.get("from_frame", 2)) - 1, 1)
@@ -93,6 +111,9 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
         np.where(visible[..., None], estimated[start:], true[start:]), true[start:], threshold, evaluation.get("loss_patience", 10)
     )
     mot = multi.clear_mot(true[1:], estimated[1:], threshold, visibility[1:] >= 0.5)
+    key = {}
+    if "key_target" in evaluation:
+        key[f"failed[target{evaluation['key_target'] + 1}]"] = float(lost[chosen.index(evaluation["key_target"])])
     return {
         "mean_error_per_target": multi.mean_error_per_target(estimated[1:], true[1:]),
         "lost_targets": int(lost.sum()),
@@ -100,6 +121,7 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
         "switches": mot["switches"],
         "mota": mot["mota"],
         "visible_error": float(errors[visible].mean()) if visible.any() else float("nan"),
+        **key,
     }
 
 
@@ -117,7 +139,8 @@ def _marginal(filters: list, index: int, strip: dict, size: tuple[int, int]) -> 
 
 def run(run: Run) -> dict:
     """Track every target of the run; numbers are averaged over targets, 'tracked to the end' needs all."""
-    sequence = cached_sequence(run.model["scene_spec"])
+    spec = scene_spec(run)
+    sequence = cached_sequence(spec)
     chosen = targets(run.model, sequence.truth.shape[1])
     cache: dict = {}
     method = build_filter(run.method, run.method_params)
@@ -130,7 +153,7 @@ def run(run: Run) -> dict:
         for target in chosen:
             method = build_filter(run.method, run.method_params)
             filters.append((method, method.start(build_model(run, sequence, target, cache), run.rng(f"filter{target}"))))
-    strip = run.model["scene_spec"].get("strip")  # a target whose marginal over x or y is kept per frame
+    strip = spec.get("strip")  # a target whose marginal over x or y is kept per frame
     densities = []
     seconds = 0.0
     for k in range(1, sequence.n_frames):
@@ -164,9 +187,11 @@ def run(run: Run) -> dict:
         "resample_rate": float(np.mean([d["resample_rate"] for d in diagnostics])),  # % of filtered frames
         "degenerate_steps": int(sum(d["degenerate_steps"] for d in diagnostics)),
     }
+    if "seed" in spec:
+        record["scene_seed"] = spec["seed"]  # the video this run saw
     if len(chosen) > 1:
-        evaluation = {**run.model.get("evaluation", {}), **run.model["scene_spec"].get("evaluation", {})}
-        record.update(multi_target_scores(evaluation, estimates, truth, sequence.visibility[:, chosen]))
+        evaluation = {**run.model.get("evaluation", {}), **spec.get("evaluation", {})}
+        record.update(multi_target_scores(evaluation, estimates, truth, sequence.visibility[:, chosen], chosen))
     for rule in tm.CORRECT_RULES:
         correct = tm.correct_frames(errors[scored], overlaps[scored], rule)
         record[f"correct_frames[{rule}]"] = float(correct.mean())
