@@ -222,3 +222,22 @@ def test_3123_hidden_targets_move_with_1_or_keep_their_own_velocity():
             assert list(side) == ([-1, 1] if target == 1 else [1, -1])  # y grows downwards
     with pytest.raises(SceneError, match="hidden_motion"):
         _3123("bounce")
+
+
+def test_random_walk_noise_on_velocity_or_position():
+    """bis_pf's balls: 'constant velocity disturbed by Gaussian noise (variance 0.4 px)' (3.2), the noise on the
+    velocity (it accumulates) or on the centre (the velocity stays); no noise, no difference."""
+    walk = {"kind": "random_walk", "start": [100, 100], "velocity": [1.0, 0.5], "max_speed": 2.0}
+    for noise_on in ("velocity", "position"):
+        still = trajectory({**walk, "noise_var": 0.0, "noise_on": noise_on}, 6, (400, 400), np.random.default_rng(0))
+        np.testing.assert_allclose(still, [[100 + k, 100 + k / 2] for k in range(6)])
+    draws = np.random.default_rng(1)
+    draws.normal(0.0, 1.0, 2)  # the unused default velocity is drawn first
+    e = 0.5 * draws.standard_normal((5, 2))  # sd 0.5, one draw per frame
+    walk["max_speed"] = 10.0  # no cap
+    on_velocity = trajectory({**walk, "noise_var": 0.25}, 6, (400, 400), np.random.default_rng(1))
+    np.testing.assert_allclose(np.diff(on_velocity, axis=0), [1.0, 0.5] + np.cumsum(e, axis=0))
+    on_position = trajectory({**walk, "noise_var": 0.25, "noise_on": "position"}, 6, (400, 400), np.random.default_rng(1))
+    np.testing.assert_allclose(np.diff(on_position, axis=0), [1.0, 0.5] + e)
+    with pytest.raises(SceneError, match="noise_on"):
+        trajectory({**walk, "noise_on": "size"}, 6, (400, 400), np.random.default_rng(1))

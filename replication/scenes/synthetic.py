@@ -33,7 +33,8 @@ Motion kinds: ``scripted`` (linear between keyframes [frame, cx, cy]),
 [[frame, vx, vy], ...]; a sudden speed change is a new segment) and
 ``random_walk`` (constant velocity disturbed by Gaussian noise of variance
 ``noise_var`` per frame, speed capped at ``max_speed``, bouncing off the
-borders: the bis_pf tennis balls).
+borders: the bis_pf tennis balls; ``noise_on: velocity``, the default, adds
+the noise to the velocity, ``position`` to the centre, the velocity kept).
 
 A scripted target hidden behind another may say so: ``hidden: {behind: 0,
 frames: [51, 70]}``.  The scene's ``hidden_motion`` then reads its script:
@@ -99,14 +100,18 @@ def trajectory(motion: dict, n_frames: int, size: tuple[int, int], rng: np.rando
     velocity = np.asarray(motion.get("velocity", rng.normal(0.0, 1.0, 2)), dtype=float)
     sd, cap, margin = np.sqrt(motion.get("noise_var", 0.4)), motion.get("max_speed", 2.0), motion.get("margin", 10)
     low, high = np.array([margin, margin]), np.array(size, dtype=float) - margin
+    noise_on = motion.get("noise_on", "velocity")
+    _require(noise_on in ("velocity", "position"), f"unknown noise_on {noise_on!r}; choose one of ('velocity', 'position')")
     path = np.empty((n_frames, 2))
     for k in range(n_frames):
         path[k] = centre
-        velocity = velocity + sd * rng.standard_normal(2)
+        noise = sd * rng.standard_normal(2)
+        if noise_on == "velocity":
+            velocity = velocity + noise
         speed = np.hypot(*velocity)
         if speed > cap:
             velocity *= cap / speed
-        centre = centre + velocity
+        centre = centre + velocity + (noise if noise_on == "position" else 0.0)
         for axis in range(2):
             if not low[axis] <= centre[axis] <= high[axis]:
                 velocity[axis] = -velocity[axis]
