@@ -132,6 +132,7 @@ def test_a_flip_names_the_alternative_and_the_best_case_for_the_paper():
     robustness = Robustness(CLAIM, cases)
     assert robustness.robust is False
     assert robustness.flips == [("x", "b", 1, 1), ("y", "b", 2, 2), (READING, "r2", 1, 1)]
+    assert "scored by 'r2' (1 of 1)" in robustness.summary
     assert robustness.best_case.universe == "x=b"
     assert "flipped under x=b (1 of 1)" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
     # between two inconclusive cases the one with more checks holding is closer
@@ -164,5 +165,5 @@ def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiv
     frame = claims_frame(rows, pd.DataFrame({"claim": []}), {})
     row = frame.iloc[0]
     assert not row["robust"] and row["robust"] is not None
-    assert row["flipped_by"] == "x=b (1 of 1)" and row["best_case"] == "x=b, r1"
+    assert row["flipped_by"] == "x=b (1 of 1)" and row["best_case"] == "x=b (scored by: r1)"
     assert row["best_case_verdict"] == "reproduced" and row["cases"] == 2 and row["multiverse"] == "hspf_readings"

@@ -31,6 +31,11 @@ from replication.runner.store import Store
 # how close a verdict is to the claim holding: the best case for the paper has the highest
 CLOSENESS = {Outcome.REPRODUCED: 3, Outcome.INCONCLUSIVE: 2, Outcome.NOT_REPRODUCED: 1, Outcome.NOT_TESTABLE: 0}
 READING = "reading"  # the scoring readings, a choice of their own beside the run-level ones
+SHOWN_FLIPS = 4  # in a claim's one-line summary; its page lists every case
+
+
+def _alternative(choice: str, alternative: str) -> str:
+    return f"scored by '{alternative}'" if choice == READING else f"{choice}={alternative}"
 
 
 @dataclass(frozen=True)
@@ -49,7 +54,7 @@ class Case:
 
     @property
     def label(self) -> str:
-        return f"{self.universe}, {dict(self.picks)[READING]}"
+        return f"{self.universe} (scored by: {dict(self.picks)[READING]})"
 
 
 @dataclass(frozen=True)
@@ -100,7 +105,9 @@ class Robustness:
             return f"not testable across readings ({len(testable)} of {len(self.cases)} cases testable)"
         if self.robust:
             return f"robust: {testable[0].verdict.outcome.value} in all {len(testable)} cases"
-        flips = "; ".join(f"{choice}={alternative} ({n} of {m})" for choice, alternative, n, m in self.flips)
+        flips = [f"{_alternative(choice, alternative)} ({n} of {m})" for choice, alternative, n, m in self.flips]
+        flips = "; ".join(flips[:SHOWN_FLIPS]) + (f"; {len(flips) - SHOWN_FLIPS} more" if len(flips) > SHOWN_FLIPS
+                                                   else "")
         best = self.best_case
         number = f" ({best.deciding['number']})" if best.deciding and best.deciding.get("number") else ""
         return (f"depends on the reading: {self.default.verdict.outcome.value} by default, flipped under {flips}; "

@@ -153,7 +153,7 @@ def _across(row: ClaimRow) -> dict:
         "cases": len(stored.get("cases", [])) or None,
         "flipped_by": "; ".join(f"{choice}={alternative} ({n} of {m})" for choice, alternative, n, m in
                                 stored.get("flips", [])),
-        "best_case": best.get("universe", "") and f"{best['universe']}, {dict(best['picks']).get('reading', '')}",
+        "best_case": best.get("universe", "") and f"{best['universe']} (scored by: {dict(best['picks'])['reading']})",
         "best_case_verdict": (best.get("verdict") or {}).get("outcome", ""),
         "best_case_number": (best.get("deciding") or {}).get("number", ""),
         "multiverse": row.multiverse_experiment,
