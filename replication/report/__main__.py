@@ -18,8 +18,10 @@ from hydra import compose, initialize_config_dir
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.report.experiment import write_experiment_report
 from replication.report.index import write_index
+from replication.report.multiverse import write_multiverse_report
 from replication.runner.cli import fail
 from replication.runner.config import ConfigError, expand
+from replication.runner.multiverse import load as load_multiverse
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
@@ -51,10 +53,12 @@ def main(argv: list[str]) -> None:
         for name in names:
             cfg = compose("config", overrides=[f"experiment={name}", *overrides])
             try:
-                runs = expand(cfg)
+                if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
+                    page = write_multiverse_report(cfg, load_multiverse(cfg))
+                else:
+                    page = write_experiment_report(cfg, expand(cfg), Store(resolve(cfg.store), name))
             except ConfigError as error:
                 fail(str(error))
-            page = write_experiment_report(cfg, runs, Store(resolve(cfg.store), name))
             print(f"{name}: {page}")
         reports = resolve(cfg.reports)
         if switches["pdf"]:

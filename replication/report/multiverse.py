@@ -159,6 +159,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
     """A forest plot per claim: the deciding check of its default case, in every universe under the claim's
     first reading, with its 95% interval, coloured by verdict; the claim's line (the paper's value, a bound
     or zero difference) dashed."""
+    path.unlink(missing_ok=True)  # a figure of runs since recomputed must not outlive them
     shown = [r for r in robustness if _headline(r)]
     if not shown:
         return
