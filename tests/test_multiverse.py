@@ -28,7 +28,9 @@ def test_designs_start_from_the_default_and_cover_what_they_say():
     sobol = design(choices, {"sobol": 8}, seed=1)
     assert sobol[0].is_default and set(sobol) <= set(full)
     assert design(choices, {"sobol": 8}, seed=1) == sobol  # seeded
-    for bad in ("all", {"sobol": 6}, {"lhs": 4}):
+    assert [u.name for u in design(choices, {"one_at_a_time": ["b"]}, seed=1)] == ["default", "b=b1", "b=b2"]
+    assert len(design(choices, {"full": ["a"]}, seed=1)) == 2
+    for bad in ("all", {"sobol": 6}, {"lhs": 4}, {"full": ["c"]}, {"one_at_a_time": []}):
         with pytest.raises(ConfigError, match="design"):
             design(choices, bad, seed=1)
 

@@ -16,6 +16,7 @@ first over several sequences, with its bootstrap stability) and
 :class:`Check` values, combined into the reading's :class:`Result`.
 """
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -307,11 +308,13 @@ def _judge_sign(difference: Estimate, lower_is_better: bool, allowed: float) -> 
 # -- claims as data ------------------------------------------------------------------------------------
 
 
-def load_papers(directory: Path = CLAIMS_DIR) -> list[Paper]:
-    """Every paper's claims, in the order the papers are numbered (``order:`` in each file)."""
+@functools.cache
+def load_papers(directory: Path = CLAIMS_DIR) -> tuple[Paper, ...]:
+    """Every paper's claims, in the order the papers are numbered (``order:`` in each file); read once
+    per process (every experiment's report asks for them)."""
     papers = []
     for path in sorted(Path(directory).glob("*.yaml")):
-        data = yaml.safe_load(path.read_text())
+        data = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
         claims = tuple(
             Claim(id=c["id"], paper=data["paper"], text=c["claim"], source=c["source"], cells=c.get("cells") or {},
                   readings=tuple(Reading(r["name"], r["experiment"], {k: v for k, v in r.items()
@@ -321,7 +324,7 @@ def load_papers(directory: Path = CLAIMS_DIR) -> list[Paper]:
             for c in data["claims"]
         )
         papers.append((data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)))
-    return [paper for _, paper in sorted(papers, key=lambda item: item[0])]
+    return tuple(paper for _, paper in sorted(papers, key=lambda item: item[0]))
 
 
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table]) -> dict:

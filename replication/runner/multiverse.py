@@ -7,7 +7,10 @@ The first alternative is the default: what the experiment configs say today.
 A *universe* picks one alternative per choice; the *design* says which
 universes are run: ``full`` (every combination), ``one_at_a_time`` (the
 default, then each other alternative alone) or ``{sobol: n}`` (n points of a
-scrambled Sobol sequence over the choices, for a product too large to run).
+scrambled Sobol sequence over the choices, for a product too large to run);
+``{full: [a, b]}`` and ``{one_at_a_time: [a, b]}`` vary only the choices
+named (a smaller design for the quick scale).  Like every setting, the design,
+the run count and the experiments may differ by scale (``{paper: .., quick: ..}``).
 
 Each universe's runs are the base experiments' runs with the alternatives'
 values set: they go through the same expansion, store (the base experiment's
@@ -33,7 +36,6 @@ from replication.paths import CONF_DIR, experiment_names
 from replication.runner.config import ConfigError, Run, at_scale
 from replication.runner.validate import prepare
 
-DESIGNS = ("full", "one_at_a_time", "sobol")
 NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 
@@ -118,22 +120,42 @@ def choices_of(spec: dict) -> tuple[Choice, ...]:
 
 
 def design(choices: tuple[Choice, ...], spec: Any, seed: int) -> tuple[Universe, ...]:
-    """The universes to run, the default first (see the module's docstring for the designs)."""
-    sizes = [len(c.alternatives) for c in choices]
-    if spec == "full":
-        picks = itertools.product(*(range(n) for n in sizes))
-    elif spec == "one_at_a_time":
-        picks = [tuple(0 for _ in sizes)] + [tuple(i if j == k else 0 for j in range(len(sizes)))
-                                              for k, n in enumerate(sizes) for i in range(1, n)]
-    elif isinstance(spec, dict) and set(spec) == {"sobol"} and _power_of_two(spec["sobol"]):
-        points = qmc.Sobol(len(sizes), scramble=True, seed=np.random.default_rng(seed)).random(spec["sobol"])
-        drawn = (points * np.array(sizes)).astype(int)
-        picks = [tuple(0 for _ in sizes)] + [tuple(int(i) for i in row) for row in drawn]
+    """The universes to run, the default first (see the module's docstring for the designs).
+
+    ``{full: [a, b]}`` or ``{one_at_a_time: [a, b]}`` vary only the choices named, the others staying
+    at their default (a smaller design for a quick look)."""
+    kind, varied, n = _design_of(spec, choices)
+    sizes = [len(c.alternatives) if c.name in varied else 1 for c in choices]
+    default = tuple(0 for _ in sizes)
+    if kind == "full":
+        picks = list(itertools.product(*(range(n) for n in sizes)))
+    elif kind == "one_at_a_time":
+        picks = [default] + [tuple(i if j == k else 0 for j in range(len(sizes)))
+                             for k, n in enumerate(sizes) for i in range(1, n)]
+    elif kind == "sobol":
+        points = qmc.Sobol(len(sizes), scramble=True, seed=np.random.default_rng(seed)).random(n)
+        picks = [default] + [tuple(int(i) for i in row) for row in (points * np.array(sizes)).astype(int)]
     else:
-        raise ConfigError(f"experiment.multiverse.design must be full, one_at_a_time or {{sobol: n}} with n a "
-                          f"power of two (Sobol points balance only then); got {spec!r}")
+        raise ConfigError(f"experiment.multiverse.design must be full, one_at_a_time, {{sobol: n}} (n a power of "
+                          f"two: Sobol points balance only then) or {{full|one_at_a_time: [choices]}}; got {spec!r}")
     picks = list(dict.fromkeys(picks))  # the default once, a Sobol point drawn twice once
     return tuple(Universe.of(choices, [c.alternatives[i] for c, i in zip(choices, p)]) for p in picks)
+
+
+def _design_of(spec: Any, choices: tuple[Choice, ...]) -> tuple[str | None, list[str], int]:
+    """(kind, the choices it varies, the number of Sobol points) of a design as written; kind None if
+    it is not one."""
+    names = [c.name for c in choices]
+    if isinstance(spec, str):
+        return spec, names, 0
+    if not isinstance(spec, dict) or len(spec) != 1:
+        return None, names, 0
+    (kind, value), = spec.items()
+    if kind == "sobol":
+        return (kind if _power_of_two(value) else None), names, value
+    if kind in ("full", "one_at_a_time") and isinstance(value, list) and value and set(value) <= set(names):
+        return kind, value, 0
+    return None, names, 0
 
 
 def _power_of_two(n: Any) -> bool:
@@ -185,8 +207,10 @@ def load(cfg: DictConfig) -> Multiverse:
     if unknown:
         raise ConfigError(f"experiment.multiverse.experiments: no experiment {unknown[0]!r}")
     bases = {name: _experiment(name) for name in experiments}
-    _check_choices(choices, bases, cfg.scale)
     universes = design(choices, spec.get("design", "full"), int(cfg.base_seed))
+    varied = {choice for u in universes for choice, alternative in u.picks
+              if alternative != next(c.default.name for c in choices if c.name == choice)}
+    _check_choices(choices, bases, cfg.scale, varied)
     top = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items() if k != "experiment"}
     runs, configs, skipped = {}, {}, {}
     for universe in universes:
@@ -214,16 +238,18 @@ def _experiment(name: str) -> dict:
     return OmegaConf.to_container(compose("config", overrides=[f"experiment={name}"]).experiment, resolve=True)
 
 
-def _check_choices(choices: tuple[Choice, ...], bases: dict[str, dict], scale: str) -> None:
-    """Every alternative's every path exists in some base experiment, and the default's values are the
-    configs' own (so the default universe is the experiments as they stand)."""
+def _check_choices(choices: tuple[Choice, ...], bases: dict[str, dict], scale: str, varied: set[str]) -> None:
+    """Every alternative's every path of a choice the design varies exists in some base experiment, and
+    the default's values are the configs' own wherever they exist (so the default universe is the
+    experiments as they stand).  A choice the design leaves at its default may set keys of experiments
+    this scale leaves out (the quick scale's smaller multiverse)."""
     for choice in choices:
         for alternative in choice.alternatives:
             for path, value in alternative.values.items():
                 places = [(name, container[key]) for name, base in bases.items()
                           for container, key in matches(base, path)]
                 where = f"experiment.choices.{choice.name}.alternatives.{alternative.name}.set.{path}"
-                if not places:
+                if not places and choice.name in varied:
                     raise ConfigError(f"{where}: no such key in {', '.join(bases)} (write the default there first)")
                 if alternative is choice.default:
                     differing = [name for name, found in places if at_scale(found, scale) != at_scale(value, scale)]
