@@ -49,6 +49,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
         entry = dict(summaries[name])
         entry["verdicts"] = ", ".join(f"{k}: {v}" for k, v in sorted(entry["verdicts"].items())) or "-"
         entry["ablation"] = "ablation" in name  # the studies on top of the papers get their own section
+        entry["multiverse"] = "multiverse" in entry  # so do the papers' readings
         experiments.append(entry)
     published = load_published(str(resolve(published_values or default_published_values())))
     papers = load_papers()
