@@ -80,18 +80,27 @@ class Robustness:
 
     @property
     def flips(self) -> list[tuple[str, str, int, int]]:
-        """(choice, alternative, cases whose verdict differs from the default's, cases) for each
-        alternative other than the default under which the verdict changes, most often first."""
-        reference = self.default.verdict.outcome
+        """(choice, alternative, flipped, compared) for each alternative other than the default under which
+        the verdict changes, most often first.
+
+        A case under the alternative is compared with its twin: the case that differs from it only in
+        that choice, set to its default (same universe otherwise, same scoring reading), so a flip is
+        the alternative's own doing.  Where a design has no twins (Sobol points), every case under the
+        alternative is compared with the default case instead."""
+        testable = self.testable
+        cases = {c.picks: c for c in testable}
         default_picks = dict(self.default.picks)
         found = []
-        for choice, alternative in dict.fromkeys(p for c in self.testable for p in c.picks):
+        for choice, alternative in dict.fromkeys(p for c in testable for p in c.picks):
             if default_picks.get(choice) == alternative:
                 continue
-            under = [c for c in self.testable if (choice, alternative) in c.picks]
-            flipped = sum(c.verdict.outcome is not reference for c in under)
+            under = [c for c in testable if (choice, alternative) in c.picks]
+            twins = [(c, cases.get(tuple((ch, default_picks[ch] if ch == choice else a) for ch, a in c.picks)))
+                     for c in under]
+            pairs = [(c, t) for c, t in twins if t is not None] or [(c, self.default) for c in under]
+            flipped = sum(c.verdict.outcome is not t.verdict.outcome for c, t in pairs)
             if flipped:
-                found.append((choice, alternative, flipped, len(under)))
+                found.append((choice, alternative, flipped, len(pairs)))
         return sorted(found, key=lambda f: -f[2] / f[3])
 
     @property
