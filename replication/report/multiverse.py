@@ -104,6 +104,11 @@ class Robustness:
         return sorted(found, key=lambda f: -f[2] / f[3])
 
     @property
+    def flipped_by(self) -> list[str]:
+        """The flips as a reader sees them: 'bests=rescored (4 of 8)', "scored by 'the other rule' (2 of 2)"."""
+        return [f"{_alternative(choice, alternative)} ({n} of {m})" for choice, alternative, n, m in self.flips]
+
+    @property
     def best_case(self) -> Case:
         return max(self.cases, key=lambda c: (CLOSENESS[c.verdict.outcome], c.held))
 
@@ -114,7 +119,7 @@ class Robustness:
             return f"not testable across readings ({len(testable)} of {len(self.cases)} cases testable)"
         if self.robust:
             return f"robust: {testable[0].verdict.outcome.value} in all {len(testable)} cases"
-        flips = [f"{_alternative(choice, alternative)} ({n} of {m})" for choice, alternative, n, m in self.flips]
+        flips = self.flipped_by
         flips = "; ".join(flips[:SHOWN_FLIPS]) + (f"; {len(flips) - SHOWN_FLIPS} more" if len(flips) > SHOWN_FLIPS
                                                    else "")
         best = self.best_case
@@ -128,7 +133,8 @@ class Robustness:
                     "deciding": c.deciding, "checks": list(c.checks)}
 
         return {"robust": self.robust, "summary": self.summary, "cases": [case(c) for c in self.cases],
-                "flips": [list(f) for f in self.flips], "best_case": case(self.best_case)}
+                "flips": [list(f) for f in self.flips], "flipped_by": self.flipped_by,
+                "best_case": case(self.best_case)}
 
 
 def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFrame) -> list[Robustness]:
@@ -199,7 +205,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
                for outcome, colour in OUTCOME_COLOURS.items()]
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=7, frameon=False)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight")  # universes' names can be long
     plt.close(fig)
 
 

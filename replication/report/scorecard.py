@@ -151,8 +151,7 @@ def _across(row: ClaimRow) -> dict:
     best = stored.get("best_case") or {}
     return {
         "cases": len(stored.get("cases", [])) or None,
-        "flipped_by": "; ".join(f"{choice}={alternative} ({n} of {m})" for choice, alternative, n, m in
-                                stored.get("flips", [])),
+        "flipped_by": "; ".join(stored.get("flipped_by", [])),
         "best_case": best.get("universe", "") and f"{best['universe']} (scored by: {dict(best['picks'])['reading']})",
         "best_case_verdict": (best.get("verdict") or {}).get("outcome", ""),
         "best_case_number": (best.get("deciding") or {}).get("number", ""),
