@@ -68,7 +68,7 @@ def motmetrics_summary(truth, est, threshold, truth_present, est_present):
         oids, hids = np.flatnonzero(truth_present[k]), np.flatnonzero(est_present[k])
         d = np.linalg.norm(truth[k, oids][:, None] - est[k, hids][None], axis=-1)
         acc.update(oids.tolist(), hids.tolist(), np.where(d < threshold, d, np.nan))
-    summary = mm.metrics.create().compute(acc, metrics=["mota", "motp", "idf1", "num_switches"], name="x")
+    summary = mm.metrics.create().compute(acc, metrics=["mota", "motp", "idf1", "num_switches", "num_fragmentations"], name="x")
     return summary.iloc[0]
 
 
@@ -87,4 +87,5 @@ def test_clear_mot_and_idf1_agree_with_motmetrics(seed):
     assert ours["mota"] == pytest.approx(theirs["mota"])
     assert ours["motp"] == pytest.approx(theirs["motp"])
     assert ours["switches"] == theirs["num_switches"]
+    assert ours["fragmentations"] == theirs["num_fragmentations"]
     assert multi.idf1(truth, est, 8.0, truth_present, est_present) == pytest.approx(theirs["idf1"])

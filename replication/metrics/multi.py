@@ -42,17 +42,19 @@ def _distances(truth_k, estimates_k, threshold):
     return np.where(d < threshold, d, np.nan)
 
 
-def clear_mot(truth, estimates, threshold, truth_present=None, estimate_present=None) -> dict:
-    """MOTA, MOTP, switches, misses, false positives and matches over all frames."""
-    truth, estimates = np.asarray(truth, float), np.asarray(estimates, float)
-    truth_present = np.ones(truth.shape[:2], bool) if truth_present is None else np.asarray(truth_present)
-    estimate_present = np.ones(estimates.shape[:2], bool) if estimate_present is None else np.asarray(estimate_present)
+def clear_mot_frames(frames) -> dict:
+    """CLEAR MOT over ``frames``: (truth ids, hypothesis ids, distances) per frame, distances NaN where a pair cannot match.
+
+    Ids may be any hashable labels.  Besides the module's counts, ``fragmentations``
+    counts, per truth track, the runs of misses between its first and last match
+    (py-motmetrics' ``num_fragmentations``).
+    """
     last = {}
-    matches = switches = misses = false_positives = 0
+    missed_since_match = {}  # truth id -> a miss happened after its last match
+    matches = switches = misses = false_positives = fragmentations = n_truth = 0
     total_distance = 0.0
-    for k in range(len(truth)):
-        oids, hids = np.flatnonzero(truth_present[k]), np.flatnonzero(estimate_present[k])
-        d = _distances(truth[k, oids], estimates[k, hids], threshold)
+    for oids, hids, d in frames:
+        oids, hids = np.asarray(oids), np.asarray(hids)
         o_done, h_done = np.zeros(len(oids), bool), np.zeros(len(hids), bool)
         pairs = []
         for i, o in enumerate(oids):  # 1. keep last frame's correspondences that still hold
@@ -61,7 +63,7 @@ def clear_mot(truth, estimates, threshold, truth_present=None, estimate_present=
                 if len(j) and np.isfinite(d[i, j[0]]):
                     o_done[i], h_done[j[0]] = True, True
                     pairs.append((i, j[0], False))
-        rest = d.copy()
+        rest = np.array(d, dtype=float).reshape(len(oids), len(hids))
         rest[o_done, :] = np.nan
         rest[:, h_done] = np.nan
         if rest.size:
@@ -71,21 +73,48 @@ def clear_mot(truth, estimates, threshold, truth_present=None, estimate_present=
                     o_done[i], h_done[j] = True, True
                     pairs.append((i, j, oids[i] in last and last[oids[i]] != hids[j]))
         for i, j, switched in pairs:
+            fragmentations += missed_since_match.get(oids[i], False)
+            missed_since_match[oids[i]] = False
             last[oids[i]] = hids[j]
             total_distance += d[i, j]
             switches += switched
+        for o in oids[~o_done]:
+            if o in missed_since_match:
+                missed_since_match[o] = True
         matches += len(pairs)
         misses += int((~o_done).sum())
         false_positives += int((~h_done).sum())
-    n_truth = int(truth_present.sum())
+        n_truth += len(oids)
     return {
-        "mota": 1.0 - (misses + false_positives + switches) / n_truth,
+        "mota": float(1.0 - (misses + false_positives + switches) / n_truth),
         "motp": total_distance / matches if matches else float("nan"),
         "switches": int(switches),
+        "fragmentations": int(fragmentations),
         "misses": misses,
         "false_positives": false_positives,
         "matches": matches,
     }
+
+
+def clear_mot(truth, estimates, threshold, truth_present=None, estimate_present=None) -> dict:
+    """MOTA, MOTP, switches, fragmentations, misses, false positives and matches over all frames."""
+    truth, estimates = np.asarray(truth, float), np.asarray(estimates, float)
+    truth_present = np.ones(truth.shape[:2], bool) if truth_present is None else np.asarray(truth_present)
+    estimate_present = np.ones(estimates.shape[:2], bool) if estimate_present is None else np.asarray(estimate_present)
+
+    def frames():
+        for k in range(len(truth)):
+            oids, hids = np.flatnonzero(truth_present[k]), np.flatnonzero(estimate_present[k])
+            yield oids, hids, _distances(truth[k, oids], estimates[k, hids], threshold)
+
+    return clear_mot_frames(frames())
+
+
+def idf1_from_counts(counts, n_truth: int, n_hypotheses: int) -> float:
+    """IDF1 from ``counts[m, k]``, the frames truth track m and hypothesis track k can match."""
+    counts = np.asarray(counts)
+    rows, cols = linear_sum_assignment(-counts)
+    return float(2 * counts[rows, cols].sum() / (n_truth + n_hypotheses))
 
 
 def idf1(truth, estimates, threshold, truth_present=None, estimate_present=None) -> float:
@@ -96,6 +125,4 @@ def idf1(truth, estimates, threshold, truth_present=None, estimate_present=None)
     close = np.linalg.norm(truth[:, :, None, :] - estimates[:, None, :, :], axis=-1) < threshold
     both = truth_present[:, :, None] & estimate_present[:, None, :]
     counts = (close & both).sum(axis=0)  # (M, K) frames each pair matches
-    rows, cols = linear_sum_assignment(-counts)
-    idtp = counts[rows, cols].sum()
-    return float(2 * idtp / (truth_present.sum() + estimate_present.sum()))
+    return idf1_from_counts(counts, truth_present.sum(), estimate_present.sum())
