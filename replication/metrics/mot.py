@@ -1,0 +1,91 @@
+"""MOT-style evaluation on boxes: CLEAR MOT and IDF1 of a hypothesis track table against MOT ground truth.
+
+Tables are DataFrames with columns frame, id, x, y, w, h (0-based top-left boxes, as
+:mod:`replication.scenes.mot` loads them).  A truth box and a hypothesis box can match
+in a frame when IoU >= ``min_iou`` (0.5, MOTChallenge's threshold; Milan et al. 2016),
+at distance 1 - IoU.  CLEAR MOT (Bernardin and Stiefelhagen 2008) and IDF1 (Ristani et
+al. 2016) are then those of :mod:`replication.metrics.multi`, computed as py-motmetrics
+does; ``motp`` is py-motmetrics' mean distance 1 - IoU over matches (MOTChallenge prints
+100 (1 - motp)).
+
+Ignore boxes (ground-truth flag 0): each frame, the hypotheses are first assigned to all
+truth and ignore boxes together by the Hungarian method maximising IoU, pairs below
+``min_iou`` discarded; a hypothesis assigned to an ignore box is removed, so it is
+neither a false positive nor a match, and ignore boxes are never misses.  This is the
+preprocessing of the MOTChallenge devkit and TrackEval (``MotChallenge2DBox``) for
+MOT16/17, where it applies to distractor classes.  As far as we know TrackEval does
+not remove hypotheses for MOT15 (PETS09-S2L1, TUD) and only drops the flag-0 truth
+boxes, which would count hypotheses on them as false positives; we apply the MOT16/17
+rule to flag-0 boxes, so our false positives on PETS09-S2L1 can be fewer than the
+MOT15 leaderboard's.
+"""
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import linear_sum_assignment
+
+from replication.metrics import multi
+from replication.metrics.tracking import iou
+
+BOX = ["x", "y", "w", "h"]
+
+
+def iou_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(N, M) IoU of boxes ``a`` (N, 4) against ``b`` (M, 4), (x, y, w, h)."""
+    a, b = np.asarray(a, float).reshape(-1, 4), np.asarray(b, float).reshape(-1, 4)
+    return iou(a[:, None, :], b[None, :, :])
+
+
+def match_boxes(a: np.ndarray, b: np.ndarray, min_iou: float) -> tuple[np.ndarray, np.ndarray]:
+    """Hungarian assignment of ``a`` to ``b`` maximising total IoU; the index pairs with IoU >= ``min_iou``."""
+    overlap = iou_matrix(a, b)
+    if overlap.size == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    rows, cols = linear_sum_assignment(np.where(overlap >= min_iou, -overlap, 0.0))
+    keep = overlap[rows, cols] >= min_iou
+    return rows[keep], cols[keep]
+
+
+def _by_frame(table: pd.DataFrame) -> dict:
+    return {frame: rows for frame, rows in table.groupby("frame", sort=False)}
+
+
+def drop_ignored(
+    hypotheses: pd.DataFrame, truth: pd.DataFrame, ignored: pd.DataFrame, min_iou: float = 0.5
+) -> pd.DataFrame:
+    """``hypotheses`` without the rows the joint assignment gives to an ignore box (module docstring)."""
+    hyp, tru, ign = _by_frame(hypotheses), _by_frame(truth), _by_frame(ignored)
+    dropped = []
+    for frame in hyp.keys() & ign.keys():
+        targets = tru[frame][BOX].to_numpy() if frame in tru else np.zeros((0, 4))
+        rows, cols = match_boxes(hyp[frame][BOX].to_numpy(), np.vstack([targets, ign[frame][BOX].to_numpy()]), min_iou)
+        dropped.extend(hyp[frame].index[rows[cols >= len(targets)]])
+    return hypotheses.drop(index=dropped)
+
+
+def frame_distances(truth: pd.DataFrame, hypotheses: pd.DataFrame, min_iou: float = 0.5):
+    """Per frame with truth or hypotheses, in order: (truth ids, hypothesis ids, 1 - IoU, NaN below ``min_iou``)."""
+    tru, hyp = _by_frame(truth), _by_frame(hypotheses)
+    empty = truth.iloc[:0]
+    for frame in sorted(tru.keys() | hyp.keys()):
+        t, h = tru.get(frame, empty), hyp.get(frame, empty)
+        distance = 1.0 - iou_matrix(t[BOX].to_numpy(), h[BOX].to_numpy())
+        yield t["id"].to_numpy(), h["id"].to_numpy(), np.where(distance <= 1.0 - min_iou, distance, np.nan)
+
+
+def mot_metrics(
+    truth: pd.DataFrame, hypotheses: pd.DataFrame, ignored: pd.DataFrame | None = None, min_iou: float = 0.5
+) -> dict:
+    """MOTA, MOTP (mean 1 - IoU), IDF1, switches, fragmentations, misses, false positives, matches, ignored hypotheses."""
+    kept = hypotheses if ignored is None else drop_ignored(hypotheses, truth, ignored, min_iou)
+    frames = list(frame_distances(truth, kept, min_iou))
+    truth_ids, hypothesis_ids = np.unique(truth["id"]), np.unique(kept["id"])
+    counts = np.zeros((len(truth_ids), len(hypothesis_ids)), int)
+    for oids, hids, d in frames:
+        i, j = np.nonzero(np.isfinite(d))
+        np.add.at(counts, (np.searchsorted(truth_ids, oids[i]), np.searchsorted(hypothesis_ids, hids[j])), 1)
+    return {
+        **multi.clear_mot_frames(frames),
+        "idf1": multi.idf1_from_counts(counts, len(truth), len(kept)),
+        "ignored_hypotheses": len(hypotheses) - len(kept),
+    }

@@ -1,0 +1,120 @@
+"""MOT metrics on boxes (hand cases, py-motmetrics on real sequences) and the SORT / detections-only references."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from replication.filters.mot_baselines import detections_only, sort
+from replication.metrics.mot import drop_ignored, iou_matrix, mot_metrics
+from replication.paths import resolve
+from replication.scenes import load_mot
+from replication.scenes.mot import MOT_ROOT
+
+HAVE_MOT = (resolve(MOT_ROOT) / "PETS09-S2L1" / "gt" / "gt.txt").exists()
+needs_mot = pytest.mark.skipif(not HAVE_MOT, reason="../shared/data/mot is not beside the project")
+COLUMNS = ["frame", "id", "x", "y", "w", "h"]
+
+
+def table(rows):
+    return pd.DataFrame(rows, columns=COLUMNS).astype({"frame": int, "id": int})
+
+
+def two_walkers(frames=10):
+    """Two people 200 px apart, each 20 x 40 px, walking right at 5 px per frame; ids 1 and 2."""
+    return table([(k, i, 10 + 5 * k + 200 * (i - 1), 50, 20, 40) for k in range(1, frames + 1) for i in (1, 2)])
+
+
+def test_iou_matrix_hand_values():
+    a = np.array([[0, 0, 10, 10], [100, 100, 5, 5]], float)
+    b = np.array([[0, 0, 10, 10], [5, 0, 10, 10], [0, 0, 0, 0]], float)
+    np.testing.assert_allclose(iou_matrix(a, b), [[1, 1 / 3, 0], [0, 0, 0]])
+    assert iou_matrix(a, np.zeros((0, 4))).shape == (2, 0)
+
+
+def test_perfect_tracker():
+    truth = two_walkers()
+    result = mot_metrics(truth, truth.assign(id=truth["id"] + 10))
+    assert (result["mota"], result["idf1"], result["motp"]) == (1.0, 1.0, 0.0)
+    assert result["switches"] == result["fragmentations"] == result["false_positives"] == result["misses"] == 0
+
+
+def test_ids_swapped_halfway():
+    truth = two_walkers()
+    hyp = truth.assign(id=np.where((truth["frame"] > 5) == (truth["id"] == 1), 2, 1))
+    result = mot_metrics(truth, hyp)
+    assert result["switches"] == 2 and result["fragmentations"] == 0
+    assert result["mota"] == pytest.approx(1 - 2 / 20)
+    assert result["idf1"] == pytest.approx(2 * 10 / 40)  # each truth keeps one hypothesis for 5 of its 10 frames
+
+
+def test_fragmentation_and_miss():
+    truth = two_walkers()
+    hyp = truth[~((truth["id"] == 1) & truth["frame"].isin([4, 5]))]
+    result = mot_metrics(truth, hyp)
+    assert (result["misses"], result["fragmentations"], result["switches"]) == (2, 1, 0)
+
+
+def test_a_box_on_an_ignore_region_counts_nothing():
+    truth = two_walkers(3)
+    ignored = table([(k, 99, 500, 300, 30, 60) for k in (1, 2, 3)])
+    on_ignore = table([(2, 7, 503, 300, 30, 60)])  # IoU 0.82 with the ignore box
+    beside_it = table([(3, 8, 520, 300, 30, 60)])  # IoU 0.2: a false positive
+    hyp = pd.concat([truth, on_ignore, beside_it], ignore_index=True)
+    result = mot_metrics(truth, hyp, ignored)
+    assert result["ignored_hypotheses"] == 1 and result["false_positives"] == 1
+    assert result["mota"] == pytest.approx(1 - 1 / 6) and result["idf1"] == pytest.approx(12 / 13)
+    # the joint assignment gives a hypothesis to the target it fits best, not to an ignore box over it
+    overlapping = table([(1, 99, 18, 50, 20, 40)])  # IoU 0.74 with target 1's box
+    assert len(drop_ignored(truth[truth["frame"] == 1].iloc[:1], truth, overlapping)) == 1
+
+
+def motmetrics_summary(truth, hyp):
+    mm = pytest.importorskip("motmetrics")
+    acc = mm.MOTAccumulator(auto_id=False)
+    for frame in sorted(set(truth["frame"]) | set(hyp["frame"])):
+        t, h = truth[truth["frame"] == frame], hyp[hyp["frame"] == frame]
+        boxes_t, boxes_h = t[COLUMNS[2:]].to_numpy(float), h[COLUMNS[2:]].to_numpy(float)
+        distance = 1 - mm.distances.boxiou(boxes_t[:, None], boxes_h[None])  # iou_matrix needs np.asfarray
+        acc.update(t["id"].tolist(), h["id"].tolist(), np.where(distance <= 0.5, distance, np.nan), frameid=frame)
+    metrics = ["mota", "motp", "idf1", "num_switches", "num_fragmentations", "num_false_positives"]
+    return mm.metrics.create().compute(acc, metrics=metrics, name="x").iloc[0]
+
+
+@needs_mot
+@pytest.mark.parametrize("tracker", [sort, detections_only])
+@pytest.mark.parametrize("name", ["PETS09-S2L1", "TUD-Campus"])
+def test_agrees_with_motmetrics_on_real_sequences(name, tracker):
+    sequence = load_mot(name)
+    hyp = tracker(sequence.detections)
+    ours = mot_metrics(sequence.truth, hyp, sequence.ignored)
+    kept = drop_ignored(hyp, sequence.truth, sequence.ignored)
+    theirs = motmetrics_summary(sequence.truth, kept)
+    assert ours["ignored_hypotheses"] == len(hyp) - len(kept) and (len(kept) < len(hyp)) == (not sequence.ignored.empty)
+    for key, their_key in [("mota", "mota"), ("motp", "motp"), ("idf1", "idf1")]:
+        assert ours[key] == pytest.approx(theirs[their_key], abs=1e-12)
+    assert ours["switches"] == theirs["num_switches"]
+    assert ours["fragmentations"] == theirs["num_fragmentations"]
+    assert ours["false_positives"] == theirs["num_false_positives"]
+
+
+def walker_detections(missing=()):
+    det = two_walkers(20).drop(columns="id").assign(score=1.0)
+    return det[~((det["x"] < 200) & det["frame"].isin(missing))].reset_index(drop=True)
+
+
+def test_sort_keeps_ids_over_a_gap_shorter_than_max_age_and_births_after_min_hits():
+    det = walker_detections(missing=(8, 9))  # the first walker is not detected in frames 8 and 9
+    tracks = sort(det, min_hits=3, max_age=3)
+    assert sorted(tracks["id"].unique()) == [1, 2]
+    assert tracks.groupby("id")["frame"].min().tolist() == [3, 3]  # born at the third consecutive match
+    first = tracks[tracks["x"] < 200]
+    assert first["id"].nunique() == 1 and sorted(first["frame"]) == [3, 4, 5, 6, 7, *range(10, 21)]
+    assert mot_metrics(two_walkers(20), tracks)["switches"] == 0
+    # with max_age = 2 the track dies in the gap: a new one is born three frames after the walker reappears
+    reborn = sort(det, min_hits=3, max_age=2)
+    assert reborn.groupby("id")["frame"].min().tolist() == [3, 3, 12]
+
+
+def test_detections_only_links_neighbours_and_restarts_after_a_gap():
+    tracks = detections_only(walker_detections(missing=(8,)))
+    assert tracks.groupby("id")["frame"].agg(["min", "max"]).values.tolist() == [[1, 7], [1, 20], [9, 20]]
