@@ -1,9 +1,18 @@
+import signal
 import sys
 
 import pytest
 from hydra import compose, initialize_config_dir
 
 from replication.paths import CONF_DIR, PROJECT_ROOT
+
+
+def pytest_configure(config):
+    """Deliver Ctrl-C as a terminal does, even when the suite was started in the background of a
+    non-interactive shell, which starts it with SIGINT ignored (and every process it spawns with it):
+    the reliability tests send SIGINT to the runner and to its workers."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture
