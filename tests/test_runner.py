@@ -137,10 +137,12 @@ def test_changed_code_lands_in_new_runs(tmp_path):
     with open(copy / "replication" / "report" / "render.py", "a") as report:
         report.write("# a report change\n")
     assert computed() == 0
+    runs_dir = copy / "experiments" / "hspf_ungm" / "runs"
+    earlier = set(runs_dir.glob("*.json"))  # they stay beside the new runs: read a new one
     with open(copy / "replication" / "filters" / "bootstrap.py", "a") as code:
         code.write("# a filter change\n")
     assert computed() == first
-    record = json.loads(next((copy / "experiments" / "hspf_ungm" / "runs").glob("*.json")).read_text())
+    record = json.loads(min(set(runs_dir.glob("*.json")) - earlier).read_text())
     assert record["code_digest"] == code_digest(copy / "replication") != code_digest()
     assert {"git_commit", "git_dirty", "numpy_version", "scipy_version", "opencv_version", "numba_version",
             "machine", "computed_at"} <= set(record)

@@ -3,8 +3,10 @@
 loop of :mod:`replication.smc.loop` with their own proposal or move.
 
 A method in an experiment config names its builder with ``filter:`` and passes
-the rest of its keys to it.  A filter with ``joint = True`` (BIS-PF) tracks all
-targets of a run together: ``start(models, rng)`` and ``step(state, z)``.
+the rest of its keys to it.  A task tracking targets in video drives every
+method through :func:`replication.filters.tracker.tracker`: one interface for
+one or many targets, the multi-target filters of :mod:`replication.filters.bis`
+stepping all targets together, any other filter one per target.
 """
 
 from replication.filters.bis import BISPF, MRFJPF

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.smc.loop import FilterOutput, Summaries
-from replication.smc.resampling import multinomial
+from replication.smc.loop import FilterOutput, ResamplingPolicy, Summaries
+from replication.smc.resampling import RESAMPLERS, multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
 
 
@@ -114,9 +114,11 @@ class JointState:
 
 
 class JointFilter:
-    """What the joint filters share: one state for all targets, started from each target's prior."""
+    """What the joint filters share: one state for all targets, started from each target's prior.
 
-    joint = True  # the tracking task hands such a filter every target of a run
+    Such a filter is its own multi-target tracker (:class:`replication.filters.tracker.Joint`).
+    """
+
     n_particles: int
 
     def start(self, models: list, rng: np.random.Generator) -> JointState:
@@ -131,14 +133,28 @@ class DistributedFilter(JointFilter):
     motion and is weighted by its own likelihood pi (bis_pf's step 1, and the
     starting point of MFMC and DMOT); ``interact(particles, pi, state)``
     returns each target's final normalised weights.
+
+    The per-target step is not the :class:`~replication.smc.loop.ParticleFilter`
+    loop: the targets share one random stream, and each resamples from its
+    *interacted* weights at the start of the next step (resample i, move i, for
+    every i, then interact), where the loop resamples at the end of its own
+    step from the likelihood weights; the loop also weights by the carried
+    log-weights plus the log-likelihood (equal only up to rounding to the
+    likelihood alone after resampling) and recovers a degenerate step from the
+    normalised predicted weights rather than exactly 1/N.  Running it on the
+    loop would change every number of bis_pf; the resampling scheme at least is
+    the loop's policy (``resampling``: multinomial, every step).
     """
+
+    resampling = ResamplingPolicy("multinomial", 1.0)
 
     def step(self, state: JointState, z) -> None:
         rng, n = state.rng, self.n_particles
+        resample = RESAMPLERS[self.resampling.scheme]
         state.t += 1
         proposed, local, degenerate = [], [], []
         for i, model in enumerate(state.models):
-            ancestors = multinomial(np.exp(state.log_weights[i]), rng)
+            ancestors = resample(np.exp(state.log_weights[i]), rng)
             particles = model.propagate(state.particles[i][ancestors], state.t, rng)
             try:
                 pi, _ = normalise(model.log_likelihood(particles, z, state.t))

@@ -20,6 +20,7 @@ Both initialise on the first frame, which ``start`` reads from ``model.first_fra
   under constant velocity v).
 """
 
+import dataclasses
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any
@@ -27,16 +28,29 @@ from typing import Any
 import cv2
 import numpy as np
 
-from replication.smc.loop import FilterOutput, FilterState
+from replication.smc.loop import FilterOutput, Summaries
 
 NEIGHBOURS = np.array([[-1, 0], [0, 1], [1, 0], [0, -1]])  # (row, col) steps of the DFT descent
 
 
 @dataclass
-class TrackerState(FilterState):
-    """A one-box tracker between frames: its box (as the single particle) and what it keeps (``tracker``)."""
+class BoxState:
+    """A one-box tracker between frames: its box (cx, cy, w, h), what it keeps (``memory``) and what it
+    has recorded (one box per frame, as a filter's summaries with ESS 1, never resampled)."""
 
-    tracker: Any = None
+    model: Any
+    rng: np.random.Generator
+    box: np.ndarray
+    memory: Any = None
+    t: int = 0
+    records: Summaries = dataclasses.field(default_factory=Summaries)
+
+    def output(self) -> FilterOutput:
+        return self.records.output(0.0)
+
+    def posterior(self) -> tuple[np.ndarray, np.ndarray]:
+        """A point mass at the box: what a one-box tracker states about the target."""
+        return self.box[None], np.zeros(1)
 
 
 def corner_box(box: np.ndarray) -> tuple[int, int, int, int]:
@@ -46,7 +60,7 @@ def corner_box(box: np.ndarray) -> tuple[int, int, int, int]:
 
 
 class BoxTracker(ABC):
-    """Drives a tracker that keeps one box through the filter interface."""
+    """A tracker that keeps one box, driven as a single-target filter: ``start(model, rng)``, ``step(state, frame)``."""
 
     deterministic = True  # the same frames give the same boxes: one run per condition is enough
 
@@ -58,19 +72,19 @@ class BoxTracker(ABC):
     def update(self, memory: Any, frame: np.ndarray) -> np.ndarray | None:
         """The box (cx, cy, w, h) in ``frame``, or None when the tracker reports failure."""
 
-    def start(self, model, rng: np.random.Generator) -> TrackerState:
+    def start(self, model, rng: np.random.Generator) -> BoxState:
         frame = getattr(model, "first_frame", None)
         if frame is None:
             raise ValueError(f"{type(self).__name__} initialises on model.first_frame, which is not set")
         box = np.asarray(model.initial_box, dtype=float)[:4]
-        return TrackerState(model, rng, box[None], np.zeros(1), tracker=self.initialise(frame, box))
+        return BoxState(model, rng, box, memory=self.initialise(frame, box))
 
-    def step(self, state: TrackerState, frame: np.ndarray) -> None:
+    def step(self, state: BoxState, frame: np.ndarray) -> None:
         state.t += 1
-        box = self.update(state.tracker, frame)
+        box = self.update(state.memory, frame)
         if box is not None:
-            state.particles = np.asarray(box, dtype=float)[None]
-        state.records.add(state.particles, np.ones(1), False)
+            state.box = np.asarray(box, dtype=float)
+        state.records.add(state.box[None], np.ones(1), False)
         state.records.resampled.append(False)
 
     def run(self, model, observations, rng: np.random.Generator) -> FilterOutput:

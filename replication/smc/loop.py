@@ -141,6 +141,10 @@ class FilterState:
     def output(self) -> FilterOutput:
         return self.records.output(self.log_evidence)
 
+    def posterior(self) -> tuple[np.ndarray, np.ndarray]:
+        """The weighted particles now (after any resampling): (particles, log-weights)."""
+        return self.particles, self.log_weights
+
 
 @dataclass
 class ParticleFilter:

@@ -1,7 +1,8 @@
-"""Filters tracking targets through an image sequence (synthetic scene or OTB), one filter per target.
+"""Trackers following targets through an image sequence (synthetic scene or OTB): one tracker for all targets.
 
 The first frame's true box initialises each filter and its reference
-histogram (the OTB one-pass protocol); frames 1..T-1 are filtered, every
+histogram (the OTB one-pass protocol); frames 1..T-1 are filtered by the
+method's tracker (:mod:`replication.filters.tracker`), every
 target's filter stepping through a frame before the next frame is produced,
 so the frame's features are computed once for all targets.  A synthetic
 scene's ``scene_seed`` says whether every run sees the configured video
@@ -10,10 +11,10 @@ frame for all targets together and exclude producing the frame (rendering or
 JPEG decoding), which the papers' videos did not pay for.
 """
 
-import time
-
 import numpy as np
 
+from replication.filters.tracker import Adaptation, Marginal
+from replication.filters.tracker import tracker as make_tracker
 from replication.metrics import multi
 from replication.metrics import tracking as tm
 from replication.metrics.scalar import filter_diagnostics
@@ -125,48 +126,23 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
     }
 
 
-def _marginal(filters: list, index: int, strip: dict, size: tuple[int, int]) -> np.ndarray:
-    """Target ``index``'s posterior over one coordinate (``strip.axis``, x or y) now: a weighted histogram."""
-    joint = getattr(filters[0][0], "joint", False)
-    state = filters[0][1] if joint else filters[index][1]
-    particles = state.particles[index] if joint else state.particles
-    log_weights = state.log_weights[index] if joint else state.log_weights
-    weights = np.exp(log_weights - log_weights.max())
-    axis = "xy".index(strip.get("axis", "x"))
-    density, _ = np.histogram(particles[:, axis], bins=strip.get("bins", 60), range=(0, size[axis]), weights=weights)
-    return density / max(density.sum(), 1e-300)
-
-
 def run(run: Run) -> dict:
     """Track every target of the run; numbers are averaged over targets, 'tracked to the end' needs all."""
     spec = scene_spec(run)
     sequence = cached_sequence(spec)
     chosen = targets(run.model, sequence.truth.shape[1])
     cache: dict = {}
-    method = build_filter(run.method, run.method_params)
-    joint = getattr(method, "joint", False)
-    if joint:  # one filter for all targets
-        joint_state = method.start([build_model(run, sequence, t, cache) for t in chosen], run.rng("filter"))
-        filters = [(method, joint_state)]
-    else:  # one independent filter per target
-        filters = []
-        for target in chosen:
-            method = build_filter(run.method, run.method_params)
-            filters.append((method, method.start(build_model(run, sequence, target, cache), run.rng(f"filter{target}"))))
+    tracker = make_tracker(lambda: build_filter(run.method, run.method_params))
+    tracker.start({t: build_model(run, sequence, t, cache) for t in chosen}, run.rng)
     strip = spec.get("strip")  # a target whose marginal over x or y is kept per frame
-    densities = []
-    seconds = 0.0
-    for k in range(1, sequence.n_frames):
-        frame = sequence.frame(k)
-        started = time.perf_counter()
-        for method, state in filters:
-            method.step(state, frame)
-            if not joint:
-                state.model.adapt(state.records.means[-1], state.t)
-        seconds += time.perf_counter() - started
-        if strip:
-            densities.append(_marginal(filters, chosen.index(strip["target"]), strip, sequence.size))
-    outputs = filters[0][1].outputs() if joint else [state.output() for _, state in filters]
+    collectors = {"alpha": Adaptation(0)}  # fusion_pf's alpha_k, first target
+    if strip:
+        axis = strip.get("axis", "x")
+        collectors["strip"] = Marginal(chosen.index(strip["target"]), axis, strip.get("bins", 60), sequence.size["xy".index(axis)])
+    for _ in tracker.track((sequence.frame(k) for k in range(1, sequence.n_frames)), collectors.values()):
+        pass
+    seconds = tracker.seconds
+    outputs = tracker.outputs()
     diagnostics = [filter_diagnostics(output) for output in outputs]
     boxes = [BoxModel.boxes(output.means) for output in outputs]
     estimates = np.stack([np.vstack([sequence.truth[:1, t], b]) for t, b in zip(chosen, boxes)], axis=1)  # (T, M, 4)
@@ -197,7 +173,7 @@ def run(run: Run) -> dict:
         record[f"correct_frames[{rule}]"] = float(correct.mean())
         record[f"tracked_to_end[{rule}]"] = float(all(tm.tracked_to_end(c) for c in correct.T))
     if strip:
-        record["strip"] = {"target": strip["target"], "axis": strip.get("axis", "x"), "density": np.round(densities, 4).tolist()}
+        record["strip"] = {"target": strip["target"], "axis": strip.get("axis", "x"), "density": np.round(collectors["strip"].value, 4).tolist()}
     record["per_frame"] = {
         "cle": np.round(errors.mean(axis=1), 3).tolist(),
         "iou": np.round(overlaps.mean(axis=1), 4).tolist(),
@@ -207,6 +183,6 @@ def run(run: Run) -> dict:
         "targets": chosen,
         "ess": [None] + np.round(np.mean([o.ess for o in outputs], axis=0), 2).tolist(),
     }
-    if not joint and hasattr(filters[0][1].model.likelihood, "history"):  # fusion_pf's alpha_k, first target
-        record["per_frame"]["alpha"] = [None] + np.round(filters[0][1].model.likelihood.history, 4).tolist()
+    if collectors["alpha"].value is not None:  # fusion_pf's alpha_k, first target
+        record["per_frame"]["alpha"] = [None] + np.round(collectors["alpha"].value, 4).tolist()
     return record
