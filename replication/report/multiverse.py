@@ -129,7 +129,8 @@ class Robustness:
 
     def as_dict(self) -> dict:
         def case(c: Case) -> dict:
-            return {"universe": c.universe, "picks": [list(p) for p in c.picks], "verdict": c.verdict.as_dict(),
+            return {"universe": c.universe, "label": c.label, "picks": [list(p) for p in c.picks],
+                    "verdict": c.verdict.as_dict(),
                     "deciding": c.deciding, "checks": list(c.checks)}
 
         return {"robust": self.robust, "summary": self.summary, "cases": [case(c) for c in self.cases],
@@ -183,6 +184,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
     for ax, claim in zip(axes[:, 0], shown):
         what = _headline(claim)
         first = claim.claim.readings[0].name
+        reference = None  # the claim's line, from its checks (never the previous claim's)
         for y, universe in enumerate(multiverse.universes):
             case = next((c for c in claim.cases if c.universe == universe.name and dict(c.picks)[READING] == first),
                         None)

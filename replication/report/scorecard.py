@@ -76,7 +76,7 @@ def claim_rows(papers: list[Paper], summaries: dict[str, dict]) -> dict[str, lis
     across = {claim: (name, stored) for name, summary in summaries.items()
               for claim, stored in summary.get("multiverse", {}).items()}
     return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings),
-                                 across.get(claim.id, ("", None))[1], across.get(claim.id, ("", None))[0])
+                                 *reversed(across.get(claim.id, ("", None))))
                         for claim in paper.claims] for paper in papers}
 
 
@@ -152,7 +152,7 @@ def _across(row: ClaimRow) -> dict:
     return {
         "cases": len(stored.get("cases", [])) or None,
         "flipped_by": "; ".join(stored.get("flipped_by", [])),
-        "best_case": best.get("universe", "") and f"{best['universe']} (scored by: {dict(best['picks'])['reading']})",
+        "best_case": best.get("label", ""),
         "best_case_verdict": (best.get("verdict") or {}).get("outcome", ""),
         "best_case_number": (best.get("deciding") or {}).get("number", ""),
         "multiverse": row.multiverse_experiment,
