@@ -10,6 +10,13 @@ from replication.runner.config import at_scale
 from replication.scenes.factory import build_sequence
 
 
+class BootstrapProposal:
+    """A test model's proposal is its motion prior (the joint filters draw through ``propose``)."""
+
+    def propose(self, particles, t, rng):
+        return self.propagate(particles, t, rng), 0.0
+
+
 def test_potential_hand_computed():
     box = np.array([10.0, 10.0, 4.0, 4.0])  # (cx, cy, w, h): area 16
     far = np.array([100.0, 10.0, 4.0, 4.0])
@@ -58,7 +65,7 @@ def test_mrf_jpf_weights_are_likelihoods_times_potentials():
     """One step of MRF-JPF on two targets with a known likelihood and no motion noise."""
     from replication.filters.bis import MRFJPF
 
-    class Still:
+    class Still(BootstrapProposal):
         def __init__(self, particles, log_like):
             self.particles, self.log_like = particles, log_like
 
@@ -148,7 +155,7 @@ def test_mcmc_chain_samples_the_posterior_of_one_target():
     """Independence MH from the predictive N(0, 1) with likelihood N(3; x, 1): the posterior is N(1.5, 0.5)."""
     from replication.filters.mcmc import MCMCPF
 
-    class Line:
+    class Line(BootstrapProposal):
         def sample_initial(self, n, rng):
             return np.tile([0.0, 0.0, 4.0, 4.0], (n, 1))
 
@@ -174,7 +181,7 @@ def test_mcmc_potential_keeps_two_targets_apart():
     """Two targets whose likelihoods both peak at x = 0: the MRF pushes the pair apart."""
     from replication.filters.mcmc import MCMCPF
 
-    class Peak:
+    class Peak(BootstrapProposal):
         def sample_initial(self, n, rng):
             return np.tile([0.0, 0.0, 10.0, 10.0], (n, 1))
 

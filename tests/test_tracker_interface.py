@@ -25,6 +25,9 @@ class Walk:
         moved[:, 0] += rng.standard_normal(len(particles))
         return moved
 
+    def propose(self, particles, t, rng):
+        return self.propagate(particles, t, rng), 0.0
+
     def log_likelihood(self, particles, z, t):
         return -0.5 * (particles[:, 0] - z) ** 2
 

@@ -9,7 +9,7 @@ one or many targets, the multi-target filters of :mod:`replication.filters.bis`
 stepping all targets together, any other filter one per target.
 """
 
-from replication.filters.bis import BISPF, MRFJPF
+from replication.filters.bis import BISPF, MIPF, MRFJPF
 from replication.filters.bootstrap import bootstrap
 from replication.filters.harmony import hs, hspf
 from replication.filters.dmot import DMOT
@@ -17,6 +17,7 @@ from replication.filters.ism import ism
 from replication.filters.mcmc import MCMCPF
 from replication.filters.mean_shift import ms, mspf
 from replication.filters.mean_field import MFMC
+from replication.filters.open_tracker import detections_only_tracker, sort_tracker
 from replication.filters.point_mass import PointMassFilter
 from replication.filters.opencv_trackers import dft, mil
 from replication.filters.pso import pso
@@ -27,6 +28,7 @@ FILTERS = {
     "point_mass": PointMassFilter,
     "pso": pso,
     "ism": ism,
+    "mipf": MIPF,
     "bis": BISPF,
     "mrf_jpf": MRFJPF,
     "mfmc": MFMC,
@@ -40,10 +42,12 @@ FILTERS = {
     "ms": ms,
     "mspf": mspf,
     "mil": mil,
+    "sort": sort_tracker,
+    "detections_only": detections_only_tracker,
     "dft": dft,
 }
 
 __all__ = [
-    "BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MRFJPF", "PointMassFilter",
+    "BISPF", "DMOT", "FILTERS", "MCMCPF", "MFMC", "MIPF", "MRFJPF", "PointMassFilter",
     "bootstrap", "dft", "gps_qmcpf", "hs", "hspf", "ism", "mil", "ms", "mspf", "nqmcpf", "pso", "tr_sqmc",
 ]

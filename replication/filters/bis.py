@@ -125,6 +125,19 @@ class JointFilter:
         n = self.n_particles
         return JointState(models, rng, [m.sample_initial(n, rng) for m in models], [np.full(n, -np.log(n)) for _ in models])
 
+    def add(self, state: JointState, model) -> None:
+        """A target is born: its particles are drawn from ``model``'s prior (a real video's births)."""
+        n = self.n_particles
+        state.models.append(model)
+        state.particles.append(model.sample_initial(n, state.rng))
+        state.log_weights.append(np.full(n, -np.log(n)))
+        state.records.append(Summaries())
+
+    def remove(self, state: JointState, index: int) -> None:
+        """Target ``index`` dies: it leaves every list of the state."""
+        for kept in (state.models, state.particles, state.log_weights, state.records):
+            del kept[index]
+
 
 class DistributedFilter(JointFilter):
     """M bootstrap PFs, one per target, whose weights an ``interact`` stage then couples.
@@ -155,9 +168,9 @@ class DistributedFilter(JointFilter):
         proposed, local, degenerate = [], [], []
         for i, model in enumerate(state.models):
             ancestors = resample(np.exp(state.log_weights[i]), rng)
-            particles = model.propagate(state.particles[i][ancestors], state.t, rng)
+            particles, log_correction = model.propose(state.particles[i][ancestors], state.t, rng)
             try:
-                pi, _ = normalise(model.log_likelihood(particles, z, state.t))
+                pi, _ = normalise(model.log_likelihood(particles, z, state.t) + log_correction)
                 degenerate.append(False)
             except DegenerateWeightsError:  # nothing seen: the prediction stands
                 pi = np.full(n, 1.0 / n)
@@ -166,6 +179,25 @@ class DistributedFilter(JointFilter):
             local.append(pi)
         for i, (particles, weights) in enumerate(zip(proposed, self.interact(proposed, local, state))):
             state.record(i, particles, weights, degenerate[i])
+
+
+@dataclass
+class MIPF(DistributedFilter):
+    """M independent bootstrap PFs: the distributed step with the identity interaction (the final weights are pi).
+
+    On a fixed set of targets MIPF runs as one :class:`~replication.smc.loop.ParticleFilter` per
+    target (``filter: bootstrap``); this form shares the joint filters' step so that on a real
+    video, with births and deaths, MIPF and BIS-PF differ only in their interaction.
+    """
+
+    n_particles: int = 400
+
+    def __post_init__(self):
+        if self.n_particles <= 0:
+            raise ValueError(f"N must be positive, got N={self.n_particles}")
+
+    def interact(self, particles: list, pi: list, state: JointState) -> list:
+        return pi
 
 
 @dataclass

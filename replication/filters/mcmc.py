@@ -8,6 +8,9 @@ As pinned in baselines.md §2.  Each frame:
    model), accept with
    min(1, L(z_i | X'_i) prod_j psi(X'_i, X_j) / (L(z_i | X_i) prod_j psi(X_i, X_j))),
    the prior terms cancelling because the proposal is the predictive mixture;
+   a model whose proposal fuses detections (:mod:`replication.models.boosted`) draws
+   from q(x' | r') instead and L(z_i | X'_i) is multiplied by p(X'_i | r') / q(X'_i | r'),
+   the chain then targeting the joint of (X'_i, r') (an auxiliary-variable MH);
 3. keep the N states after burn-in (equal weights): the estimate is their mean;
    the ``carry`` (10 in bis_pf) best of them by likelihood times potentials
    (tracked incrementally; the predictive prior is not scored) go to the next frame.
@@ -91,6 +94,14 @@ class MCMCPF(JointFilter):
         state.carried = [p[: self.carry] for p in state.particles]  # the joint samples the next frame starts from
         return state
 
+    def add(self, state: JointState, model) -> None:
+        super().add(state, model)
+        state.carried.append(state.particles[-1][: self.carry])
+
+    def remove(self, state: JointState, index: int) -> None:
+        super().remove(state, index)
+        del state.carried[index]
+
     def step(self, state: JointState, z) -> None:
         rng, m = state.rng, len(state.models)
         state.t += 1
@@ -102,15 +113,16 @@ class MCMCPF(JointFilter):
         proposals = np.empty((total, carried[0].shape[1]))
         log_like = np.empty(total)
         chosen = [np.flatnonzero(targets == i) for i in range(m)]
+        log_correction = np.zeros(total)  # log p / q of a proposal: 0 for the predictive mixture itself
         for i, model in enumerate(state.models):  # every proposal, one pass per target
-            proposals[chosen[i]] = model.propagate(carried[i][sources[chosen[i]]], state.t, rng)
+            proposals[chosen[i]], log_correction[chosen[i]] = model.propose(carried[i][sources[chosen[i]]], state.t, rng)
         start = int(rng.integers(len(carried[0])))
         initial = np.stack([model.propagate(p[start : start + 1], state.t, rng)[0] for model, p in zip(state.models, carried)])
         reachable = [np.vstack([proposals[chosen[i]], initial[i]]) for i in range(m)]
         initial_like = np.empty(m)
         for i, model in enumerate(state.models):  # the likelihoods of a target's proposals and start, one call
             scored = model.log_likelihood(reachable[i], z, state.t)
-            log_like[chosen[i]], initial_like[i] = scored[:-1], scored[-1]
+            log_like[chosen[i]], initial_like[i] = scored[:-1] + log_correction[chosen[i]], scored[-1]
         adjacent = np.zeros((m, m), dtype=bool)
         for i, j in neighbours(reachable):
             adjacent[i, j] = adjacent[j, i] = True

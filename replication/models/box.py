@@ -105,12 +105,27 @@ class BoxModel:
             [rng.standard_normal((n, 2)), rng.standard_normal((n, 2))])
         return self.constrain(self.f(particles, t) + e @ self.noise_factor.T)
 
+    def propose(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | float]:
+        """Draw x_t from the proposal given x_{t-1} = ``particles``, with log p(x_t | x_{t-1}) / q(x_t | ...),
+        the term an importance weight adds to the log-likelihood.  Here the proposal is the motion
+        prior (the bootstrap filter), so the term is 0."""
+        return self.propagate(particles, t, rng), 0.0
+
     def log_likelihood(self, particles: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
         """N log-likelihoods; the frame's features are computed once per frame and reused by moves
         and by the other targets' models that share ``cache``."""
+        return self.likelihood.log_likelihood(particles[:, :4], self.prepared(frame, t))
+
+    def similarity(self, states: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
+        """The Bhattacharyya coefficient rho of each state's box against the reference (the frame's
+        features shared with :meth:`log_likelihood` through ``cache``)."""
+        return self.likelihood.similarity(states[:, :4], self.prepared(frame, t))[0]
+
+    def prepared(self, frame: np.ndarray, t: int):
+        """The likelihood's features of ``frame`` (step ``t``), computed once per step for every model sharing ``cache``."""
         if self.cache.get("t") != t:
             self.cache.update(t=t, prepared=self.likelihood.prepare(frame))
-        return self.likelihood.log_likelihood(particles[:, :4], self.cache["prepared"])
+        return self.cache["prepared"]
 
     def adapt(self, estimate: np.ndarray, t: int) -> None:
         """Let an adaptive likelihood (fusion_pf eqs 6-7) update itself at the frame's estimated state."""

@@ -6,8 +6,8 @@ experiment config names it with ``task:``.
 """
 
 from replication.scenes.factory import SequenceMissing as DataMissing
-from replication.tasks import scalar, tracking
+from replication.tasks import mot, scalar, tracking
 
-TASKS = {"scalar": scalar, "tracking": tracking}
+TASKS = {"scalar": scalar, "tracking": tracking, "mot": mot}
 
 __all__ = ["TASKS", "DataMissing"]

@@ -59,14 +59,14 @@ def check(model: dict, method: dict) -> None:
     for target in targets(model, sequence.truth.shape[1]):
         if not 0 <= target < sequence.truth.shape[1]:
             raise ValueError(f"target {target} not in the scene's {sequence.truth.shape[1]} targets")
-    ColourHistogram(**_histogram_args(observation, (8, 8), np.random.default_rng(0)))  # validation only
+    ColourHistogram(**histogram_args(observation, (8, 8), np.random.default_rng(0)))  # validation only
     unknown = set(observation) - {"kind", "bins", "kernel", "grid", "samples", "sigma", *FUSION_KEYS}
     if unknown:
         raise ValueError(f"unknown observation keys {sorted(unknown)}")
     BoxModel(np.zeros(4), None, **model.get("motion", {}))
 
 
-def _histogram_args(observation: dict, box_size, rng) -> dict:
+def histogram_args(observation: dict, box_size, rng) -> dict:
     grid = observation.get("grid") or tuple(max(int(round(v)), 1) for v in box_size)
     return {
         "bins": tuple(observation.get("bins", (8, 8, 4))),
@@ -81,7 +81,7 @@ def build_model(run: Run, sequence, target: int, cache: dict) -> BoxModel:
     observation = run.model.get("observation", {})
     x, y, w, h = sequence.truth[0, target]
     initial = np.array([x + w / 2, y + h / 2, w, h])
-    histogram = ColourHistogram(**_histogram_args(observation, (w, h), run.rng(f"pattern{target}")))
+    histogram = ColourHistogram(**histogram_args(observation, (w, h), run.rng(f"pattern{target}")))
     first = sequence.frame(0)
     if observation.get("kind", "colour") == "fusion":
         fusion = {k: observation[k] for k in FUSION_KEYS if k in observation}

@@ -1,0 +1,138 @@
+"""Trackers of an open set of targets on a real video: targets are born and die (bis_pf Experiment 6).
+
+Every such tracker has one method, ``track(sequence, frames, rng)``, which owns the time loop
+over a :class:`~replication.scenes.mot.MotSequence`'s ``frames`` (MOT numbers) and yields,
+per frame, the ids (from 1) and (x, y, w, h) boxes it outputs; ``seconds`` adds up its
+own time (decoding the frames excluded, as bis_pf's timings exclude it).
+
+* :class:`ParticleTracker`: a joint filter of :mod:`replication.filters.bis` (MIPF,
+  BIS-PF, MFMC, DMOT, MCMC-PF) over the targets alive, with the births, deaths and
+  association of :mod:`replication.filters.track_management` and each target's
+  detection fed to its proposal (:mod:`replication.models.boosted`).  The filters share
+  all of that machinery and differ only in their interaction.
+* :class:`DetectionTracker`: a reference built from the public detections alone
+  (:mod:`replication.filters.mot_baselines`), for context.
+
+Per frame, a particle tracker: associates the detections with the tracks' boxes of the
+previous frame; steps the joint filter (each target's proposal fed its detection); marks
+each track supported or not and ends the dead ones; outputs the tracks alive (by
+default only in frames where they are supported: ``output: supported``; ``alive``
+outputs every frame of a track's life); then starts the tracks born this frame, each
+with its colour reference from its first detection's box in this frame.
+"""
+
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+import pandas as pd
+
+from replication.filters.bis import JointFilter
+from replication.filters.mot_baselines import detections_only, sort
+from replication.filters.track_management import Deleter, Initiator, associate
+from replication.metrics.mot import BOX
+from replication.models.box import BoxModel
+
+OUTPUTS = ("supported", "alive")
+Frame = tuple[int, np.ndarray, np.ndarray]  # MOT frame number, ids (K,), boxes (K, 4)
+
+
+def _centred(boxes: np.ndarray) -> np.ndarray:
+    """(cx, cy, w, h) of (x, y, w, h) boxes."""
+    return np.column_stack([boxes[:, :2] + boxes[:, 2:4] / 2, boxes[:, 2:4]])
+
+
+def frame_detections(sequence, min_score: float) -> dict[int, np.ndarray]:
+    """Each frame's detection boxes (x, y, w, h) of score at least ``min_score``."""
+    kept = sequence.detections[sequence.detections["score"] >= min_score]
+    return {int(frame): rows[BOX].to_numpy(float) for frame, rows in kept.groupby("frame")}
+
+
+@dataclass
+class ParticleTracker:
+    """A joint filter over the targets alive, with births, deaths and the detection-fused proposal.
+
+    ``new_model(image, box)`` makes a target's model from its first detection (cx, cy, w, h)
+    in ``image``.
+    """
+
+    method: JointFilter
+    new_model: Callable[[np.ndarray, np.ndarray], BoxModel]
+    births: Initiator
+    deaths: Deleter
+    association_iou: float = 0.3  # not stated: our choice, SORT's gate
+    min_score: float = -np.inf  # detections below are ignored
+    output: str = "supported"
+    seconds: float = field(default=0.0, init=False)
+    born: int = field(default=0, init=False)  # tracks started
+
+    def __post_init__(self):
+        if self.output not in OUTPUTS:
+            raise ValueError(f"unknown output {self.output!r}; choose one of {OUTPUTS}")
+
+    def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
+        detections = frame_detections(sequence, self.min_score)
+        state = self.method.start([], rng)
+        ids, boxes, unsupported = np.zeros(0, int), np.zeros((0, 4)), np.zeros(0, int)
+        for frame in frames:
+            image = sequence.image(frame)
+            started = time.perf_counter()
+            found = detections.get(frame, np.zeros((0, 4)))
+            assigned = associate(boxes, found, self.association_iou)
+            for model, index in zip(state.models, assigned):
+                model.detection = _centred(found[index : index + 1])[0] if index >= 0 else None
+            if len(ids):
+                self.method.step(state, image)
+                means = np.array([records.means[-1][:4] for records in state.records])
+                boxes = BoxModel.boxes(means)
+                rho = np.array([model.similarity(mean[None], image, state.t)[0] for model, mean in zip(state.models, means)])
+                supported = self.deaths.supported(assigned >= 0, rho)
+                unsupported = np.where(supported, 0, unsupported + 1)
+                dead = self.deaths.dead(unsupported, boxes, sequence.size)
+                shown = ~dead & (supported | (self.output == "alive"))
+                out_ids, out_boxes = ids[shown], boxes[shown]
+                for index in np.flatnonzero(dead)[::-1]:
+                    self.method.remove(state, int(index))
+                ids, boxes, unsupported = ids[~dead], boxes[~dead], unsupported[~dead]
+            else:
+                out_ids, out_boxes = ids, boxes
+            taken = np.isin(np.arange(len(found)), assigned)
+            born = self.births.step(found[~taken], boxes)
+            for box in born:
+                self.method.add(state, self.new_model(image, _centred(box[None])[0]))
+            new_ids = np.arange(self.born + 1, self.born + len(born) + 1)
+            self.born += len(born)
+            ids, boxes = np.concatenate([ids, new_ids]), np.vstack([boxes, born])
+            unsupported = np.concatenate([unsupported, np.zeros(len(born), int)])
+            self.seconds += time.perf_counter() - started
+            yield frame, np.concatenate([out_ids, new_ids]), np.vstack([out_boxes, born])
+
+
+@dataclass
+class DetectionTracker:
+    """A reference tracker on the detections alone: ``link(detections)`` gives the whole track table."""
+
+    link: Callable[[pd.DataFrame], pd.DataFrame]
+    seconds: float = field(default=0.0, init=False)
+
+    def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
+        frames = list(frames)
+        started = time.perf_counter()
+        table = self.link(sequence.detections[sequence.detections["frame"].isin(frames)])
+        self.seconds += time.perf_counter() - started
+        by_frame = {frame: rows for frame, rows in table.groupby("frame")}
+        for frame in frames:
+            rows = by_frame.get(frame, table.iloc[:0])
+            yield frame, rows["id"].to_numpy(), rows[BOX].to_numpy(float)
+
+
+def sort_tracker(**settings) -> DetectionTracker:
+    """SORT on the public detections (:func:`replication.filters.mot_baselines.sort`)."""
+    return DetectionTracker(partial(sort, **settings))
+
+
+def detections_only_tracker(**settings) -> DetectionTracker:
+    """The public detections linked frame to frame (:func:`replication.filters.mot_baselines.detections_only`)."""
+    return DetectionTracker(partial(detections_only, **settings))

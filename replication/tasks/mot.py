@@ -1,0 +1,114 @@
+"""Tracking an open set of people through a real MOT sequence (bis_pf Experiment 6, PETS 2009).
+
+The scene is ``kind: mot`` (a MOTChallenge folder, :mod:`replication.scenes.mot`) with the
+frames ``first`` to ``last`` (MOT numbers, inclusive; ``last`` empty: to the end).  The
+method is a joint particle filter run by :class:`~replication.filters.open_tracker.ParticleTracker`
+(births, deaths, the detection-fused proposal: the model's ``births``, ``deaths``,
+``association`` and ``proposal`` settings) or a reference on the detections alone.
+A target's colour model (the kernel histogram of ``observation``) is taken from its first
+detection's box; its motion is ``motion`` (a random walk).
+
+The record holds the MOT metrics of its track table against the ground truth of those
+frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.metrics.mot`),
+the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
+frame, id, x, y, w, h) for the pictures.
+"""
+
+from functools import lru_cache
+
+import numpy as np
+import pandas as pd
+
+from replication.filters.bis import JointFilter
+from replication.filters.open_tracker import DetectionTracker, ParticleTracker
+from replication.filters.track_management import Deleter, Initiator
+from replication.metrics.mot import BOX, mot_metrics
+from replication.models.boosted import BoostedBoxModel
+from replication.runner.config import Run, build_filter
+from replication.scenes.mot import MOT_ROOT, load_mot
+from replication.tasks.tracking import histogram_args
+from replication.vision.colour import ColourLikelihood
+from replication.vision.histogram import ColourHistogram
+
+SCENE_KEYS = {"kind", "name", "root", "first", "last", "stand_in"}
+MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal", "min_iou"}
+
+
+@lru_cache(maxsize=4)
+def sequence_of(name: str, root: str):
+    return load_mot(name, root)
+
+
+def frames_of(spec: dict, sequence) -> range:
+    """The MOT frame numbers a run covers: ``first`` (default 1) to ``last`` (default the last)."""
+    first, last = spec.get("first", 1), spec.get("last") or sequence.n_frames
+    if not 1 <= first <= last <= sequence.n_frames:
+        raise ValueError(f"{sequence.name}: frames {first}..{last} outside 1..{sequence.n_frames}")
+    return range(first, last + 1)
+
+
+def _tracker(run_model: dict, method, new_model) -> ParticleTracker | DetectionTracker:
+    """The open-set tracker of a configured method: a joint filter gets the births, deaths and association."""
+    if isinstance(method, DetectionTracker):
+        return method
+    if not isinstance(method, JointFilter):
+        raise ValueError(f"{type(method).__name__} tracks a fixed set of targets; a real video needs a joint filter "
+                         "(mipf, bis, mfmc, dmot, mcmc) or a detection tracker (sort, detections_only)")
+    association = run_model.get("association", {})
+    return ParticleTracker(
+        method, new_model, Initiator(**run_model.get("births", {})), Deleter(**run_model.get("deaths", {})),
+        association_iou=association.get("min_iou", 0.3), min_score=association.get("min_score", -np.inf),
+        output=association.get("output", "supported"),
+    )
+
+
+def _model_builder(run_model: dict, rng: np.random.Generator):
+    """``new_model(image, box)``: a target's model with its colour reference from ``box`` (cx, cy, w, h) in ``image``."""
+    observation, cache = run_model.get("observation", {}), {}
+
+    def new_model(image: np.ndarray, box: np.ndarray) -> BoostedBoxModel:
+        histogram = ColourHistogram(**histogram_args(observation, box[2:4], rng))
+        likelihood = ColourLikelihood.from_frame(image, box, histogram, observation.get("sigma", 0.1))
+        return BoostedBoxModel(box, likelihood, cache=cache, **run_model.get("motion", {}), **run_model.get("proposal", {}))
+
+    return new_model
+
+
+def check(model: dict, method: dict) -> None:
+    spec = model.get("scene_spec")
+    if spec is None or spec.get("kind") != "mot":
+        raise ValueError("a mot experiment needs model.scene naming a scene of kind: mot")
+    unknown = (set(spec) - SCENE_KEYS) | (set(model) - MODEL_KEYS)
+    if unknown:
+        raise ValueError(f"unknown keys {sorted(unknown)}")
+    frames_of(spec, sequence_of(spec["name"], spec.get("root", MOT_ROOT)))
+    ColourHistogram(**histogram_args(model.get("observation", {}), (8, 8), np.random.default_rng(0)))
+    BoostedBoxModel(np.ones(4), None, **model.get("motion", {}), **model.get("proposal", {}))
+    method_object = build_filter("check", method)
+    _tracker(model, method_object, None)
+
+
+def run(run: Run) -> dict:
+    spec = run.model["scene_spec"]
+    sequence = sequence_of(spec["name"], spec.get("root", MOT_ROOT))
+    frames = frames_of(spec, sequence)
+    tracker = _tracker(run.model, build_filter(run.method, run.method_params), _model_builder(run.model, run.rng("pattern")))
+    rows = [
+        (frame, int(i), *box)
+        for frame, ids, boxes in tracker.track(sequence, frames, run.rng("filter"))
+        for i, box in zip(ids, boxes)
+    ]
+    tracks = pd.DataFrame(rows, columns=["frame", "id", *BOX]).astype({"frame": int, "id": int})
+    truth, ignored = (table[table["frame"].isin(frames)] for table in (sequence.truth, sequence.ignored))
+    scores = mot_metrics(truth, tracks, ignored, run.model.get("min_iou", 0.5))
+    return {
+        "sequence": sequence.name,
+        "first_frame": frames.start,
+        "last_frame": frames.stop - 1,
+        "frames": len(frames),
+        **scores,
+        "tracks_started": int(tracks["id"].nunique()),
+        "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
+        "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
+        "tracks": np.round(tracks.to_numpy(float), 1).tolist(),
+    }

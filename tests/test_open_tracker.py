@@ -1,0 +1,112 @@
+"""Births, deaths and the detection-fused proposal on cases with exact answers (issue 17, item 2)."""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import multivariate_normal
+
+from replication.filters import FILTERS
+from replication.filters.open_tracker import ParticleTracker
+from replication.filters.track_management import Deleter, Initiator, associate
+from replication.models.boosted import BoostedBoxModel
+from replication.vision.colour import ColourLikelihood
+from replication.vision.histogram import ColourHistogram
+
+
+def test_associate_takes_the_overlapping_detection_and_rejects_below_the_gate():
+    tracks = np.array([[0, 0, 10, 10], [100, 100, 10, 10]], float)
+    detections = np.array([[101, 101, 10, 10], [50, 50, 10, 10], [1, 0, 10, 10]], float)
+    assert associate(tracks, detections, 0.3).tolist() == [2, 0]
+    assert associate(tracks, detections[1:2], 0.3).tolist() == [-1, -1]
+
+
+def test_a_detection_is_born_on_its_third_consecutive_frame_and_not_when_a_track_explains_it():
+    births = Initiator(frames=3, min_iou=0.3, explained_iou=0.3)
+    person, none = np.array([[10.0, 10, 20, 40]]), np.zeros((0, 4))
+    assert len(births.step(person, none)) == 0
+    assert len(births.step(person + 1, none)) == 0
+    assert births.step(person + 2, none).tolist() == (person + 2).tolist()  # frame 3: born
+    explained = Initiator(frames=1)
+    assert len(explained.step(person, person + 1)) == 0  # a track already sits on it
+    gap = Initiator(frames=3)
+    gap.step(person, none), gap.step(none, none), gap.step(person, none)
+    assert len(gap.step(person, none)) == 0  # the streak restarted after the gap: 2 frames so far
+
+
+def test_a_track_dies_after_its_unsupported_frames_or_when_it_leaves_the_image():
+    deaths = Deleter(frames=3, min_rho=0.7)
+    assert deaths.supported(np.array([True, False, False]), np.array([0.1, 0.8, 0.6])).tolist() == [True, True, False]
+    boxes = np.array([[10, 10, 20, 40], [10, 10, 20, 40], [95, 10, 20, 40]], float)
+    dead = deaths.dead(np.array([2, 3, 0]), boxes, (100, 100))
+    assert dead.tolist() == [False, True, True]  # 3 frames unsupported; centre x = 105 is outside
+
+
+def _model(alpha, detection=None):
+    model = BoostedBoxModel(np.array([50.0, 50, 20, 40]), None, step_sd=(4.0, 4.0, 1.0, 2.0), alpha=alpha,
+                            detection_sd=(0.1, 0.1, 0.05, 0.05))
+    model.detection = detection
+    return model
+
+
+def test_the_proposal_is_the_prior_without_a_detection_or_with_alpha_zero():
+    previous = np.tile([50.0, 50, 20, 40], (5, 1))
+    for model in (_model(0.5), _model(0.0, np.array([60.0, 50, 20, 40]))):
+        moved, correction = model.propose(previous, 1, np.random.default_rng(3))
+        assert np.array_equal(moved, model.propagate(previous, 1, np.random.default_rng(3)))
+        assert correction == 0.0
+
+
+def test_the_importance_correction_is_log_prior_over_the_mixture_density():
+    detection = np.array([60.0, 52, 22, 38])
+    model = _model(0.3, detection)
+    previous = np.array([[50.0, 50, 20, 40], [58.0, 51, 21, 39]])
+    moved, correction = model.propose(previous, 1, np.random.default_rng(0))
+    prior = [multivariate_normal(p, np.diag(np.square([4.0, 4.0, 1.0, 2.0]))).pdf(x) for p, x in zip(previous, moved)]
+    near = multivariate_normal(detection, np.diag(np.square([2.2, 3.8, 1.1, 1.9]))).pdf(moved)
+    assert np.allclose(correction, np.log(prior) - np.log(0.3 * near + 0.7 * np.array(prior)), rtol=1e-10)
+
+
+def test_importance_weights_make_the_mixture_unbiased_for_the_prior():
+    """E_q[f p / q] = E_p[f]: with a flat likelihood the weighted mean is the prior's (the ancestor)."""
+    model = _model(0.7, np.array([70.0, 40, 24, 44]))
+    previous = np.tile([50.0, 50, 20, 40], (400_000, 1))
+    moved, correction = model.propose(previous, 1, np.random.default_rng(1))
+    weights = np.exp(correction)
+    assert weights.mean() == pytest.approx(1.0, abs=0.02)
+    assert (weights @ moved / weights.sum()) == pytest.approx([50.0, 50, 20, 40], abs=0.15)
+
+
+@dataclass
+class _Square:
+    """A MOT-like sequence: one red square on grey, frames 3-10 detected, gone from frame 11."""
+
+    size = (120, 90)
+    n_frames = 16
+    detections = pd.DataFrame(
+        [(f, 40.0 + f, 30.0, 16.0, 16.0, 1.0) for f in range(3, 11)], columns=["frame", "x", "y", "w", "h", "score"])
+
+    def image(self, frame):
+        image = np.full((90, 120, 3), 128, np.uint8)
+        if frame <= 10:
+            image[30:46, 40 + frame: 56 + frame] = (30, 30, 220)
+        return image
+
+
+@pytest.mark.parametrize("method", ["mipf", "bis", "mfmc", "dmot", "mcmc"])
+def test_a_target_is_born_from_persistent_detections_and_dies_after_its_absence(method):
+    params = {"n_particles": 200} if method != "bis" else {"n_particles": 200, "n_joint": 500}
+    cache: dict = {}
+
+    def new_model(image, box):
+        histogram = ColourHistogram(bins=(8, 8, 4), kernel="epanechnikov", grid=(8, 8))
+        return BoostedBoxModel(box, ColourLikelihood.from_frame(image, box, histogram, 0.1), cache=cache,
+                               step_sd=(2.0, 2.0, 0.5, 0.5), alpha=0.5)
+
+    tracker = ParticleTracker(FILTERS[method](**params), new_model, Initiator(frames=3), Deleter(frames=3, min_rho=0.7))
+    out = {frame: ids.tolist() for frame, ids, _ in tracker.track(_Square(), range(1, 17), np.random.default_rng(0))}
+    assert all(out[f] == [] for f in (1, 2, 3, 4))  # detected from frame 3: born on its third, frame 5
+    assert all(out[f] == [1] for f in range(5, 11))
+    assert all(out[f] == [] for f in range(11, 17))  # gone: unsupported from 11, dead at 13, never output again
+    assert tracker.born == 1
