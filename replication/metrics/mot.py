@@ -89,3 +89,22 @@ def mot_metrics(
         "idf1": multi.idf1_from_counts(counts, len(truth), len(kept)),
         "ignored_hypotheses": len(hypotheses) - len(kept),
     }
+
+
+def clear_mot_matches(
+    truth: pd.DataFrame, hypotheses: pd.DataFrame, ignored: pd.DataFrame | None = None, min_iou: float = 0.5
+) -> pd.DataFrame:
+    """The matches :func:`mot_metrics` counts, one row each: frame, truth_id, hypothesis_id, switch.
+
+    The same matching as :func:`mot_metrics` (hypotheses on ignore boxes dropped, then
+    :func:`replication.metrics.multi.match_frames` on 1 - IoU): ``switch`` marks a
+    truth matched to another hypothesis than at its last match (py-motmetrics' SWITCH
+    rows; the others are its MATCH rows).  Rows are in frame order.
+    """
+    kept = hypotheses if ignored is None else drop_ignored(hypotheses, truth, ignored, min_iou)
+    numbers = sorted(set(truth["frame"]) | set(kept["frame"]))  # frame_distances' order
+    matched = multi.match_frames(frame_distances(truth, kept, min_iou))
+    rows = [(frame, oids[i], hids[j], switched)
+            for frame, (oids, hids, _, pairs) in zip(numbers, matched) for i, j, switched in pairs]
+    table = pd.DataFrame(rows, columns=["frame", "truth_id", "hypothesis_id", "switch"])
+    return table.astype({"frame": int, "truth_id": int, "hypothesis_id": int, "switch": bool})

@@ -42,17 +42,12 @@ def _distances(truth_k, estimates_k, threshold):
     return np.where(d < threshold, d, np.nan)
 
 
-def clear_mot_frames(frames) -> dict:
-    """CLEAR MOT over ``frames``: (truth ids, hypothesis ids, distances) per frame, distances NaN where a pair cannot match.
-
-    Ids may be any hashable labels.  Besides the module's counts, ``fragmentations``
-    counts, per truth track, the runs of misses between its first and last match
-    (py-motmetrics' ``num_fragmentations``).
-    """
+def match_frames(frames):
+    """CLEAR MOT's correspondences, frame by frame: for each (truth ids, hypothesis ids, distances) of
+    ``frames`` (distances NaN where a pair cannot match), yield it back with its matches, a list of
+    (truth index, hypothesis index, switched) into the ids, ``switched`` when the truth was last
+    matched to another hypothesis (py-motmetrics' SWITCH)."""
     last = {}
-    missed_since_match = {}  # truth id -> a miss happened after its last match
-    matches = switches = misses = false_positives = fragmentations = n_truth = 0
-    total_distance = 0.0
     for oids, hids, d in frames:
         oids, hids = np.asarray(oids), np.asarray(hids)
         o_done, h_done = np.zeros(len(oids), bool), np.zeros(len(hids), bool)
@@ -72,18 +67,35 @@ def clear_mot_frames(frames) -> dict:
                 if np.isfinite(rest[i, j]):
                     o_done[i], h_done[j] = True, True
                     pairs.append((i, j, oids[i] in last and last[oids[i]] != hids[j]))
+        for i, j, _ in pairs:
+            last[oids[i]] = hids[j]
+        yield oids, hids, d, pairs
+
+
+def clear_mot_frames(frames) -> dict:
+    """CLEAR MOT over ``frames``: (truth ids, hypothesis ids, distances) per frame, distances NaN where a pair cannot match.
+
+    Ids may be any hashable labels.  Besides the module's counts, ``fragmentations``
+    counts, per truth track, the runs of misses between its first and last match
+    (py-motmetrics' ``num_fragmentations``).  The matching is :func:`match_frames`.
+    """
+    missed_since_match = {}  # truth id -> a miss happened after its last match
+    matches = switches = misses = false_positives = fragmentations = n_truth = 0
+    total_distance = 0.0
+    for oids, hids, d, pairs in match_frames(frames):
+        matched = np.zeros(len(oids), bool)
         for i, j, switched in pairs:
             fragmentations += missed_since_match.get(oids[i], False)
             missed_since_match[oids[i]] = False
-            last[oids[i]] = hids[j]
+            matched[i] = True
             total_distance += d[i, j]
             switches += switched
-        for o in oids[~o_done]:
+        for o in oids[~matched]:
             if o in missed_since_match:
                 missed_since_match[o] = True
         matches += len(pairs)
-        misses += int((~o_done).sum())
-        false_positives += int((~h_done).sum())
+        misses += len(oids) - len(pairs)
+        false_positives += len(hids) - len(pairs)
         n_truth += len(oids)
     return {
         "mota": float(1.0 - (misses + false_positives + switches) / n_truth),

@@ -46,7 +46,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
             draw(records, figure_spec, experiment, out / file)
-            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file})
+            link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
+            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link})
         records.drop(columns=["per_frame", "strip"], errors="ignore").to_csv(out / "runs.csv", index=False)
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}

@@ -196,6 +196,7 @@ def _legend(ax) -> int:
 
 
 def _figures():
+    from replication.report.mot_figures import identity_timeline, track_snapshots, track_video
     from replication.report.qmc_figures import point_sets
     from replication.report.tracking_figures import mode_strip, otb_curves, per_frame_curve, snapshots, track
 
@@ -207,6 +208,9 @@ def _figures():
         "mode_strip": mode_strip,
         "point_sets": point_sets,
         "otb_curves": otb_curves,
+        "track_snapshots": track_snapshots,
+        "identity_timeline": identity_timeline,
+        "track_video": track_video,
     }
 
 
