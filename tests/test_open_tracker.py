@@ -110,3 +110,15 @@ def test_a_target_is_born_from_persistent_detections_and_dies_after_its_absence(
     assert all(out[f] == [1] for f in range(5, 11))
     assert all(out[f] == [] for f in range(11, 17))  # gone: unsupported from 11, dead at 13, never output again
     assert tracker.born == 1
+
+
+def test_the_matched_centre_error_averages_the_centre_distances_of_the_clear_mot_matches():
+    from replication.metrics.mot import clear_mot_matches, matched_centre_error
+
+    truth = pd.DataFrame([(1, 1, 0, 0, 10, 10), (1, 2, 50, 0, 10, 10), (2, 1, 0, 0, 10, 10)],
+                         columns=["frame", "id", "x", "y", "w", "h"])
+    found = pd.DataFrame([(1, 7, 1, 0, 10, 10), (1, 8, 90, 90, 10, 10), (2, 7, 0, 2, 10, 10)],
+                         columns=["frame", "id", "x", "y", "w", "h"])
+    matches = clear_mot_matches(truth, found)
+    assert matches[["frame", "truth_id", "hypothesis_id"]].values.tolist() == [[1, 1, 7], [2, 1, 7]]
+    assert matched_centre_error(truth, found, matches) == pytest.approx((1.0 + 2.0) / 2)  # track 8 matches nothing

@@ -48,7 +48,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             draw(records, figure_spec, experiment, out / file)
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link})
-        records.drop(columns=["per_frame", "strip"], errors="ignore").to_csv(out / "runs.csv", index=False)
+        records.drop(columns=["per_frame", "strip", "tracks"], errors="ignore").to_csv(out / "runs.csv", index=False)
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}
     verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])

@@ -73,6 +73,9 @@ METHODS = {  # config key -> look; every method of conf/experiment/*.yaml
     "MSPF": Look(SKY, "--", ">"),
     "DFT": Look(PURPLE, "-", "h"),
     "MIL": Look(YELLOW, "-", "*"),
+    # references on the public detections alone (bis_pf_pets)
+    "SORT": Look(BLACK, "-", "o"),
+    "Detections": Look(BLACK, ":", "x"),
     # the Bayes-optimal reference (point-mass filter)
     "grid": Look(BLACK, "--", ""),
     # ablations: ISM-PF's c1, fusion_pf's fixed alpha

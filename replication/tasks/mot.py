@@ -9,8 +9,10 @@ A target's colour model (the kernel histogram of ``observation``) is taken from 
 detection's box; its motion is ``motion`` (a random walk).
 
 The record holds the MOT metrics of its track table against the ground truth of those
-frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.metrics.mot`),
-the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
+frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.metrics.mot`;
+HOTA by TrackEval: :mod:`replication.metrics.hota`),
+bis_pf's error (the distance from a person's box centre to the centre of the track matched
+to it, in px, averaged over every match), the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
 frame, id, x, y, w, h) for the pictures.
 """
 
@@ -22,7 +24,8 @@ import pandas as pd
 from replication.filters.bis import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator
-from replication.metrics.mot import BOX, mot_metrics
+from replication.metrics.hota import hota
+from replication.metrics.mot import BOX, clear_mot_matches, matched_centre_error, mot_metrics
 from replication.models.boosted import BoostedBoxModel
 from replication.runner.config import Run, build_filter
 from replication.scenes.mot import MOT_ROOT, load_mot
@@ -98,9 +101,14 @@ def run(run: Run) -> dict:
         for frame, ids, boxes in tracker.track(sequence, frames, run.rng("filter"))
         for i, box in zip(ids, boxes)
     ]
-    tracks = pd.DataFrame(rows, columns=["frame", "id", *BOX]).astype({"frame": int, "id": int})
+    tracks = pd.DataFrame(rows, columns=["frame", "id", *BOX]).round(1).astype({"frame": int, "id": int})  # as stored
     truth, ignored = (table[table["frame"].isin(frames)] for table in (sequence.truth, sequence.ignored))
-    scores = mot_metrics(truth, tracks, ignored, run.model.get("min_iou", 0.5))
+    min_iou = run.model.get("min_iou", 0.5)
+    scores = {
+        **mot_metrics(truth, tracks, ignored, min_iou),
+        **hota(truth, tracks, ignored, min_iou),
+        "mean_error_per_target": matched_centre_error(truth, tracks, clear_mot_matches(truth, tracks, ignored, min_iou)),
+    }
     return {
         "sequence": sequence.name,
         "first_frame": frames.start,
@@ -110,5 +118,5 @@ def run(run: Run) -> dict:
         "tracks_started": int(tracks["id"].nunique()),
         "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
-        "tracks": np.round(tracks.to_numpy(float), 1).tolist(),
+        "tracks": tracks.to_numpy(float).tolist(),
     }
