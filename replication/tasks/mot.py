@@ -55,7 +55,7 @@ def _tracker(run_model: dict, method, new_model) -> ParticleTracker | DetectionT
     if isinstance(method, DetectionTracker):
         return method
     if not isinstance(method, JointFilter):
-        raise ValueError(f"{type(method).__name__} tracks a fixed set of targets; a real video needs a joint filter "
+        raise TypeError(f"{type(method).__name__} tracks a fixed set of targets; a real video needs a joint filter "
                          "(mipf, bis, mfmc, dmot, mcmc) or a detection tracker (sort, detections_only)")
     association = run_model.get("association", {})
     return ParticleTracker(
