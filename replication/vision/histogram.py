@@ -433,18 +433,23 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
                             hist[spare + g] += w
                         else:
                             hist[np.int64(flat[y + x]) * GROUP + g] += w
+        acc = np.zeros(GROUP)  # each box's sum of sqrt(c_u) sqrt(q_u)
+        for u in range(n_bins):  # the group's bins in one pass: a bin is one cache line of its 8 boxes' counts
+            h = u * GROUP
+            either = ((hist[h] + hist[h + 1]) + (hist[h + 2] + hist[h + 3])) + ((hist[h + 4] + hist[h + 5]) + (hist[h + 6] + hist[h + 7]))
+            if either != 0.0:  # the weights are positive (or NaN): a zero sum is eight empty counts
+                for g in range(m):
+                    count = hist[h + g]
+                    if count != 0.0:
+                        acc[g] += np.sqrt(count) * root[u]
+                        hist[h + g] = 0.0
         for g in range(m):
             outside = hist[n_bins * GROUP + g]
             total = whole[g] - outside  # all the kernel's weight but the points outside the image
             hist[n_bins * GROUP + g] = 0.0
             if total <= 1e-9 * whole[g]:  # nothing inside, up to rounding
                 total = 0.0
-            s = np.nan if np.isnan(outside) else 0.0  # a NaN weight outside (zero-size diagonal box): NaN, as numpy's dot
-            for u in range(n_bins):
-                count = hist[u * GROUP + g]
-                if count != 0.0:
-                    s += np.sqrt(count) * root[u]
-                    hist[u * GROUP + g] = 0.0
+            s = np.nan if np.isnan(outside) else acc[g]  # a NaN weight outside (zero-size diagonal box): NaN, as numpy's dot
             rho[start + g] = s / np.sqrt(total if total > 0 else 1.0)
             valid[start + g] = total > 0
     return rho, valid
