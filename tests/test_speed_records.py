@@ -95,3 +95,24 @@ if __name__ == "__main__":  # print the values to store in EXPECTED
     np.set_printoptions(precision=17)
     for name in sorted(RUNS):
         print(f"    {name!r}: {record(name)!r},")
+
+
+def test_bootstrap_histograms_equal_the_numpy_form_to_the_bit():
+    """The compiled pair potentials and tallies against the numpy form they replaced (issue 18), with
+    targets of equal and of different particle counts."""
+    from replication.filters.bis import bootstrap_histograms, neighbours, pairwise_log_potential
+    from replication.smc.resampling import multinomial
+
+    rng = np.random.default_rng(3)
+    for sizes in ([50, 50, 50, 50], [30, 70, 50]):
+        particles = [np.column_stack([rng.normal(40, 6, (n, 2)), rng.uniform(8, 12, (n, 2)), rng.normal(0, 1, (n, 2))])
+                     for n in sizes]
+        pi = [rng.dirichlet(np.ones(n) * 0.3) for n in sizes]
+        got = bootstrap_histograms(particles, pi, 500, 4.0, np.random.default_rng(9))
+        draw_rng = np.random.default_rng(9)  # the code before: the same draws, numpy potentials and bincounts
+        draws = [multinomial(p, draw_rng, size=500) for p in pi]
+        log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], 4.0, neighbours(particles))
+        w = np.exp(log_w - log_w.max())
+        expected = [np.bincount(d, weights=w, minlength=len(p)) for d, p in zip(draws, particles)]
+        for g, e in zip(got, expected):
+            np.testing.assert_array_equal(g, e / e.sum())

@@ -99,7 +99,8 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
     else:  # targets with different N: the numpy form
         log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
-    return [h / h.sum() for h in _tally(draws, w, max(len(p) for p in particles))[: len(particles)]]
+    tallies = _tally(draws, w, max(len(p) for p in particles))
+    return [h[: len(p)] / h[: len(p)].sum() for h, p in zip(tallies, particles)]  # np.bincount's minlength=len(p)
 
 
 @njit(cache=True)
