@@ -1,23 +1,42 @@
 """``make benchmark`` (``python benchmarks/benchmark.py``): what the core costs on this machine.
 
 1. The colour likelihood: particles per second for N = 10, 100, 1000 boxes of
-   40 x 40 px on a 480 x 410 frame, our one-call vectorised histograms against
-   a per-particle loop of ``cv2.calcHist`` (unweighted: cheaper than the kernel
-   histogram it stands for) and a per-particle numpy loop of the same kernel histogram.
-2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6.
+   40 x 40 px on a 480 x 410 frame, our compiled kernel histograms (every
+   pixel, and 100 sampled pixels) against a per-particle loop of
+   ``cv2.calcHist`` (unweighted: cheaper than the kernel histogram it stands
+   for), the vectorised numpy path the kernel replaced, and a per-particle
+   loop of the same kernel histogram.
+2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6, beside
+   the same bootstrap PF in Chopin's ``particles`` when it is installed
+   (``pip install particles``; not a dependency of the project).
 3. Rendering a 480 x 410 synthetic frame with 36 targets.
 4. BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second
-   against the paper's 5.52, and a profile of where the time goes.
+   against the paper's 5.52, a profile of where the time goes, and its time
+   per frame against the number of targets M (the paper claims O(M)).
+5. The three ratios of issue 18, each against its peer measured in this run:
+   the likelihood against the calcHist loop at N = 1000 (>= 10), BIS-PF
+   against the paper's frame rate (>= 10), and the PF step at N = 100,000
+   against ``particles`` (<= 1).
+
+BLAS runs one thread, as in the experiments' workers (joblib's loky limits
+each worker to cpu_count // n_jobs threads: one on this two-core machine);
+with its default threads, the weighted means and ESS of a 100,000-particle
+step (numpy dot products) are several times slower on a busy machine.
 
 Writes ``reports/benchmark/`` (CSV, figures, a page the report index links).
 A script, not a test: timings depend on the machine and its load.
 """
 
-import platform
-import time
+import os
 
-import cv2
-import matplotlib
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads BLAS
+    os.environ.setdefault(_variable, "1")
+
+import platform  # noqa: E402
+import time  # noqa: E402
+
+import cv2  # noqa: E402
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -36,6 +55,11 @@ from replication.vision.colour import ColourLikelihood  # noqa: E402
 from replication.vision.histogram import ColourHistogram  # noqa: E402
 
 BINS = (8, 8, 4)
+OURS = "compiled kernel, all 40x40 pixels (the likelihood)"
+CALCHIST = "per-particle cv2.calcHist loop (no kernel)"
+PF_STEP = "bootstrap PF step (UNGM)"
+PARTICLES = "particles (Chopin): bootstrap PF step (UNGM)"
+PAPER_FPS = 5.52  # bis_pf, Table 1: BIS-PF on the 36 balls, 1.4 GHz Pentium 4
 
 
 def best_of(call, repeats: int = 5) -> float:
@@ -61,17 +85,22 @@ def likelihood_throughput() -> pd.DataFrame:
     for n in (10, 100, 1000):
         boxes = box + np.column_stack([rng.normal(0, 8, (n, 2)), np.zeros((n, 2))])
         for name, histogram in (
-            ("vectorised, all 40x40 pixels", ColourHistogram(BINS, grid=(40, 40))),
-            ("vectorised, 100 sampled pixels", ColourHistogram(BINS, samples=100, rng=rng)),
+            (OURS, ColourHistogram(BINS, grid=(40, 40))),
+            ("compiled kernel, 100 sampled pixels", ColourHistogram(BINS, samples=100, rng=rng)),
         ):
             likelihood = ColourLikelihood.from_frame(frame, box, histogram, sigma=0.1)
             prepared = likelihood.prepare(frame)  # once per frame, whatever N: timed on its own below
-            seconds = best_of(lambda: likelihood.log_likelihood(boxes, prepared))
+            likelihood.log_likelihood(boxes, prepared)  # numba loads the compiled kernel on the first call
+            seconds = best_of(lambda: likelihood.log_likelihood(boxes, prepared), repeats=9)
             rows.append({"method": name, "N": n, "seconds": seconds})
-        seconds = best_of(lambda: [_calchist(hsv, b) for b in boxes], repeats=3)
-        rows.append({"method": "per-particle cv2.calcHist loop (no kernel)", "N": n, "seconds": seconds})
+        seconds = best_of(lambda: [_calchist(hsv, b) for b in boxes], repeats=5)
+        rows.append({"method": CALCHIST, "N": n, "seconds": seconds})
         kernel = ColourHistogram(BINS, grid=(40, 40))
-        bin_image = ColourLikelihood.from_frame(frame, box, kernel, 0.1).prepare(frame)
+        likelihood = ColourLikelihood.from_frame(frame, box, kernel, 0.1)
+        bin_image = likelihood.prepare(frame)
+        seconds = best_of(lambda: kernel.bhattacharyya_numpy(bin_image, boxes, likelihood.reference))
+        rows.append({"method": "vectorised numpy (cv2.remap + bincount: before issue 18), all 40x40 pixels", "N": n,
+                     "seconds": seconds})
         seconds = best_of(lambda: [kernel.of_boxes(bin_image, b[None]) for b in boxes], repeats=3)
         rows.append({"method": "per-particle loop of the same kernel histogram", "N": n, "seconds": seconds})
     likelihood = ColourLikelihood.from_frame(frame, box, ColourHistogram(BINS), sigma=0.1)
@@ -90,18 +119,53 @@ def _calchist(hsv, box):
     return cv2.calcHist([roi], [0, 1, 2], None, list(BINS), [0, 180, 0, 256, 0, 256])
 
 
+def particles_peer(model: UNGM, observations):
+    """The same bootstrap PF (systematic resampling every step, no history kept) in Chopin's
+    ``particles``, as a function of N; None when it is not installed."""
+    try:
+        import particles
+        from particles import distributions as dists
+        from particles import state_space_models as ssm
+    except ImportError:
+        return None
+
+    class ParticlesUNGM(ssm.StateSpaceModel):  # gps_qmcpf eqs (11)-(12), particles' t = ours - 1
+        default_params = {"Q": model.Q, "R": model.R, "x0": model.x0, "P0": model.P0}
+
+        def PX0(self):
+            return dists.Normal(loc=self.x0, scale=np.sqrt(self.P0))
+
+        def PX(self, t, xp):
+            return dists.Normal(loc=0.5 * xp + 25.0 * xp / (1.0 + xp**2) + 8.0 * np.cos(1.2 * t), scale=np.sqrt(self.Q))
+
+        def PY(self, t, xp, x):
+            return dists.Normal(loc=x**2 / 20.0, scale=np.sqrt(self.R))
+
+    fk = ssm.Bootstrap(ssm=ParticlesUNGM(), data=list(observations))
+
+    def run(n):
+        particles.SMC(fk=fk, N=n, resampling="systematic", ESSrmin=1.0, collect=None, store_history=False).run()
+
+    return run
+
+
 def smc_core() -> pd.DataFrame:
     rng = np.random.default_rng(0)
     model = UNGM(steps=20)
     observations = model.simulate(rng)[1]
+    peer = particles_peer(model, observations)
     rows = []
     for n in (100, 1_000, 10_000, 100_000, 1_000_000):
         weights = rng.dirichlet(np.ones(n))
         for scheme, resample in RESAMPLERS.items():
             rows.append({"what": f"resample ({scheme})", "N": n, "us_per_call": 1e6 * best_of(lambda: resample(weights, rng))})
         pf = bootstrap(n, "systematic", 1.0)
-        seconds = best_of(lambda: pf.run(model, observations, rng), repeats=3) / model.steps
-        rows.append({"what": "bootstrap PF step (UNGM)", "N": n, "us_per_call": 1e6 * seconds})
+        pf.run(model, observations[:1], rng)  # the compiled resampler's first call
+        seconds = best_of(lambda: pf.run(model, observations, rng), repeats=5) / model.steps
+        rows.append({"what": PF_STEP, "N": n, "us_per_call": 1e6 * seconds})
+        if peer is not None:
+            seconds = best_of(lambda: peer(n), repeats=5) / model.steps
+            rows.append({"what": PARTICLES, "N": n, "us_per_call": 1e6 * seconds})
     for points in (801, 1601, 3201):
         seconds = best_of(lambda: PointMassFilter(points).run(model, observations), repeats=3) / model.steps
         rows.append({"what": "point-mass filter step (UNGM)", "N": points, "us_per_call": 1e6 * seconds})
@@ -118,8 +182,9 @@ def rendering() -> pd.DataFrame:
                           "ms_per_target": 1e3 * seconds / 36}])
 
 
-def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame]:
-    """BIS-PF's frame rate on the bis_pf 36-ball scene, and its profile by function."""
+def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """BIS-PF's frame rate on the bis_pf 36-ball scene, its profile by function, and its time per
+    frame against the number of targets M (with a least-squares line and the log-log slope)."""
     import cProfile
     import pstats
 
@@ -133,7 +198,7 @@ def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame]:
 
     experiment = at_scale(OmegaConf.to_container(OmegaConf.load(CONF_DIR / "experiment" / "bis_pf.yaml")), "quick")
     scene = build_sequence(experiment["scenes"]["exp3_36_targets"])
-    frames = [scene.frame(k) for k in range(1, 41)]
+    frames = [scene.frame(k) for k in range(1, 42)]
 
     class Run:  # what build_model reads of a run
         model = {**experiment["model"], "scene_spec": experiment["scenes"]["exp3_36_targets"]}
@@ -146,13 +211,14 @@ def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame]:
     models = [build_model(Run, scene, m, cache) for m in range(36)]
     bis = BISPF(n_particles=400, n_joint=4000, beta=4.0)
     state = bis.start(models, np.random.default_rng(1))
+    bis.step(state, frames[0])  # numba loads the compiled kernels on the first frame: not timed
     started = time.perf_counter()
-    for frame in frames[:20]:
+    for frame in frames[1:21]:
         bis.step(state, frame)
     fps = 20 / (time.perf_counter() - started)
     profile = cProfile.Profile()
     profile.enable()
-    for frame in frames[20:]:
+    for frame in frames[21:]:
         bis.step(state, frame)
     profile.disable()
     stats = pstats.Stats(profile).stats
@@ -161,8 +227,22 @@ def bis_pf_36() -> tuple[pd.DataFrame, pd.DataFrame]:
          for name, (cc, nc, tt, ct, callers) in stats.items()),
         key=lambda r: -r["seconds (self)"],
     )[:12]
-    speed = pd.DataFrame([{"scene": "36 balls, 480x410", "N": 400, "K": 4000, "frames_per_s": fps, "paper_frames_per_s": 5.52}])
-    return speed, pd.DataFrame(rows)
+    scaling = []
+    for m in (4, 9, 16, 25, 36):  # the first M balls, the same frames
+        state = bis.start(models[:m], np.random.default_rng(1))
+        bis.step(state, frames[0])
+        started = time.perf_counter()
+        for frame in frames[1:11]:
+            bis.step(state, frame)
+        scaling.append({"M": m, "ms_per_frame": 1e3 * (time.perf_counter() - started) / 10})
+    scaling = pd.DataFrame(scaling)
+    slope, intercept = np.polyfit(scaling["M"], scaling["ms_per_frame"], 1)
+    log_slope = np.polyfit(np.log(scaling["M"]), np.log(scaling["ms_per_frame"]), 1)[0]
+    scaling["linear_fit_ms"] = intercept + slope * scaling["M"]
+    scaling.attrs.update(slope=slope, intercept=intercept, log_slope=log_slope)
+    speed = pd.DataFrame([{"scene": "36 balls, 480x410", "N": 400, "K": 4000, "frames_per_s": fps,
+                           "paper_frames_per_s": PAPER_FPS}])
+    return speed, pd.DataFrame(rows), scaling
 
 
 def _loglog(table, x, y, group, path, ylabel):
@@ -178,34 +258,108 @@ def _loglog(table, x, y, group, path, ylabel):
     plt.close(fig)
 
 
+def ratios(likelihood: pd.DataFrame, core: pd.DataFrame, bis_speed: pd.DataFrame) -> pd.DataFrame:
+    """Issue 18's three ratios, each against its peer measured in this run."""
+    at = likelihood[likelihood["N"] == 1000].set_index("method")["seconds"]
+    step = core[core["N"] == 100_000].set_index("what")["us_per_call"]
+    fps = float(bis_speed["frames_per_s"].iloc[0])
+    rows = [
+        {"ratio": "colour likelihood, N = 1000, every pixel of 40x40 kernel-weighted: speed / per-particle cv2.calcHist loop",
+         "value": at[CALCHIST] / at[OURS], "target": ">= 10", "met": at[CALCHIST] / at[OURS] >= 10,
+         "ours": f"{1e3 * at[OURS]:.2f} ms", "peer": f"{1e3 * at[CALCHIST]:.2f} ms (calcHist loop, this run)"},
+        {"ratio": "BIS-PF on the 36 balls (N = 400, K = 4000): frames/s / the paper's",
+         "value": fps / PAPER_FPS, "target": ">= 10", "met": fps / PAPER_FPS >= 10,
+         "ours": f"{fps:.1f} frames/s", "peer": f"{PAPER_FPS} frames/s (bis_pf Table 1, 1.4 GHz Pentium 4)"},
+    ]
+    if PARTICLES in step:
+        value = step[PF_STEP] / step[PARTICLES]
+        rows.append({"ratio": "bootstrap PF step, UNGM, N = 100,000: time / particles' time", "value": value,
+                     "target": "<= 1", "met": value <= 1, "ours": f"{step[PF_STEP] / 1e3:.2f} ms",
+                     "peer": f"{step[PARTICLES] / 1e3:.2f} ms (particles, this run)"})
+    else:
+        rows.append({"ratio": "bootstrap PF step, UNGM, N = 100,000: time / particles' time", "value": np.nan,
+                     "target": "<= 1", "met": None, "ours": f"{step[PF_STEP] / 1e3:.2f} ms",
+                     "peer": "particles not installed here (pip install particles)"})
+    return pd.DataFrame(rows)
+
+
+def throughput_plot(likelihood: pd.DataFrame, core: pd.DataFrame, path) -> None:
+    """Particles per second against N: the likelihood and its peers, the PF step and particles'."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    per_particle = likelihood[~likelihood["method"].str.startswith("per frame")]
+    steps = core[core["what"].isin([PF_STEP, PARTICLES])].assign(particles_per_s=lambda t: t["N"] / (t["us_per_call"] / 1e6))
+    for ax, table, group, title in ((axes[0], per_particle, "method", "colour likelihood (40x40 boxes)"),
+                                    (axes[1], steps, "what", "bootstrap PF step (UNGM)")):
+        for name, rows in table.groupby(group, sort=False):
+            ax.loglog(rows["N"], rows["particles_per_s"], marker="o", label=name)
+        ax.set_xlabel("N")
+        ax.set_ylabel("particles per second")
+        ax.set_title(title, fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def scaling_plot(scaling: pd.DataFrame, path) -> None:
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    ax.plot(scaling["M"], scaling["ms_per_frame"], "o", label="BIS-PF, measured")
+    ax.plot(scaling["M"], scaling["linear_fit_ms"], "-",
+            label=f"least squares: {scaling.attrs['intercept']:.2f} + {scaling.attrs['slope']:.3f} M ms "
+                  f"(log-log slope {scaling.attrs['log_slope']:.2f})")
+    ax.set_xlabel("targets M (N = 400, K = 4000)")
+    ax.set_ylabel("ms per frame")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main() -> None:
     retain_freed_memory()  # as every experiment's run does
     out = resolve("reports") / "benchmark"
     out.mkdir(parents=True, exist_ok=True)
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
-    bis_speed, bis_profile = bis_pf_36()
+    bis_speed, bis_profile, bis_scaling = bis_pf_36()
+    summary = ratios(likelihood, core, bis_speed)
     for name, table in (("likelihood", likelihood), ("smc_core", core), ("rendering", render_cost),
-                        ("bis_pf_speed", bis_speed), ("bis_pf_profile", bis_profile)):
+                        ("bis_pf_speed", bis_speed), ("bis_pf_profile", bis_profile), ("bis_pf_scaling", bis_scaling),
+                        ("ratios", summary)):
         table.to_csv(out / f"{name}.csv", index=False)
         print(table.to_string(index=False), end="\n\n")
+    print(f"BIS-PF time per frame against M: slope {bis_scaling.attrs['slope']:.3f} ms per target, "
+          f"log-log slope {bis_scaling.attrs['log_slope']:.2f} (O(M): 1)\n")
     per_particle = likelihood[~likelihood["method"].str.startswith("per frame")]
     _loglog(per_particle, "N", "particles_per_s", "method", out / "likelihood.png", "particles per second")
     _loglog(core, "N", "us_per_call", "what", out / "smc_core.png", "µs per call (best of repeats)")
+    throughput_plot(likelihood, core, out / "throughput.png")
+    scaling_plot(bis_scaling, out / "bis_pf_scaling.png")
     (out / "index.html").write_text(
         render(
             "sections.html.j2",
             title="Benchmark: cost of the likelihood, the SMC core and scene rendering",
             up="../index.html",
             up_label="all experiments",
-            meta=f"Machine: {platform.machine()}, Python {platform.python_version()}, numpy {np.__version__}, "
-            f"OpenCV {cv2.__version__}. Best of several calls, single process. Made by make benchmark.",
+            meta=f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+            f"numpy {np.__version__}, OpenCV {cv2.__version__}. Best of several calls, single process, one BLAS "
+            "thread (as the experiments' workers). Made by make benchmark.",
             sections=[
+                {"title": "Issue 18's ratios, each against its peer measured in this run",
+                 "figure": None, "table": html_table(summary.round(2))},
+                {"title": "Throughput against N: ours and the peers (particles per second)",
+                 "figure": "throughput.png", "table": ""},
                 {"title": "Colour likelihood throughput (480x410 frame, 40x40 boxes, 8x8x4 bins)",
                  "figure": "likelihood.png", "table": html_table(likelihood.round(5))},
                 {"title": "SMC core", "figure": "smc_core.png", "table": html_table(core.round(2))},
                 {"title": "Scene rendering", "figure": None, "table": html_table(render_cost.round(3))},
                 {"title": "BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second",
                  "figure": None, "table": html_table(bis_speed.round(2))},
+                {"title": f"BIS-PF time per frame against the number of targets M: "
+                          f"{bis_scaling.attrs['slope']:.3f} ms per target, log-log slope "
+                          f"{bis_scaling.attrs['log_slope']:.2f} (the paper's O(M): 1)",
+                 "figure": "bis_pf_scaling.png", "table": html_table(bis_scaling.round(3))},
                 {"title": "BIS-PF profile over 20 frames: where the time goes (self time per function)",
                  "figure": None, "table": html_table(bis_profile.round(4))},
             ],

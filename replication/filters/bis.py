@@ -27,6 +27,7 @@ and variance grow exponentially with the number of targets.
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from replication.smc.loop import FilterOutput, ResamplingPolicy, Summaries
 from replication.smc.resampling import RESAMPLERS, multinomial
@@ -82,13 +83,51 @@ def pairwise_log_potential(states: list, beta: float, pairs: list | None = None)
 
 
 def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np.random.Generator) -> list:
-    """The marginal posteriors W_i (eq 10) from K joint bootstrap draws weighted by the MRF (eqs 5-8, 11)."""
-    draws = [multinomial(p, rng, size=k) for p in pi]  # B_i(k), eq (5)
-    drawn = [p[d] for p, d in zip(particles, draws)]
-    log_w = pairwise_log_potential(drawn, beta, neighbours(particles))  # eq (8); draws lie in their clouds
+    """The marginal posteriors W_i (eq 10) from K joint bootstrap draws weighted by the MRF (eqs 5-8, 11).
+
+    The draws B_i(k) are each target's K uniforms, drawn target after target, through the linear
+    inverse CDF of :func:`~replication.smc.resampling.multinomial`; the potentials of the
+    neighbouring pairs and the K-draw tallies are compiled loops over the drawn indices
+    (:func:`_draw_log_potential`, :func:`_tally`), with no (K, 4) copy of each target's drawn
+    states; the arithmetic and its order are those of :func:`pairwise_log_potential` and
+    ``np.bincount``, so the histograms are the same to the bit.
+    """
+    draws = np.stack([multinomial(p, rng, size=k) for p in pi])  # B_i(k), eq (5)
+    pairs = np.array(neighbours(particles), dtype=np.int64).reshape(-1, 2)  # eq (8); draws lie in their clouds
+    if len({len(p) for p in particles}) == 1:
+        log_w = _draw_log_potential(np.stack(particles).astype(float, copy=False), draws, pairs, float(beta))
+    else:  # targets with different N: the numpy form
+        log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
-    histograms = [np.bincount(d, weights=w, minlength=len(p)) for d, p in zip(draws, particles)]
-    return [h / h.sum() for h in histograms]
+    tallies = _tally(draws, w, max(len(p) for p in particles))
+    return [h[: len(p)] / h[: len(p)].sum() for h, p in zip(tallies, particles)]  # np.bincount's minlength=len(p)
+
+
+@njit(cache=True)
+def _draw_log_potential(states, draws, pairs, beta):
+    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k:
+    :func:`log_potential` of :func:`box_overlap`, in the same operations and order."""
+    total = np.zeros(draws.shape[1])
+    for p in range(pairs.shape[0]):
+        i, j = pairs[p, 0], pairs[p, 1]
+        for k in range(draws.shape[1]):
+            a, b = states[i, draws[i, k]], states[j, draws[j, k]]
+            dx = min(a[0] + a[2] / 2, b[0] + b[2] / 2) - max(a[0] - a[2] / 2, b[0] - b[2] / 2)
+            dy = min(a[1] + a[3] / 2, b[1] + b[3] / 2) - max(a[1] - a[3] / 2, b[1] - b[3] / 2)
+            overlap = (dx if not dx < 0 else 0.0) * (dy if not dy < 0 else 0.0)  # np.clip(., 0, None)
+            ratio = overlap * overlap / (a[2] * a[3] * b[2] * b[3])
+            total[k] += -beta * (ratio * ratio)
+    return total
+
+
+@njit(cache=True)
+def _tally(draws, w, n):
+    """Each target's ``np.bincount(B_i, weights=w, minlength=n)``, in the order of the draws."""
+    out = np.zeros((draws.shape[0], n))
+    for i in range(draws.shape[0]):
+        for k in range(draws.shape[1]):
+            out[i, draws[i, k]] += w[k]
+    return out
 
 
 @dataclass

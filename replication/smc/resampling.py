@@ -4,24 +4,140 @@ Each returns ``len(weights)`` indices (int64) such that the expected number of
 copies of particle i is ``N * W_i`` (unbiasedness); they differ in the variance
 of those counts.  See Douc, Cappé and Moulines (2005), "Comparison of
 resampling schemes for particle filtering".
+
+Every scheme finds its indices by inverse CDF in linear time, compiled, with
+no binary search: stratified and systematic uniforms come sorted, so one merge
+pass over them and C; multinomial ones do not, and a guide table (Chen and
+Asau, 1974: the first index of C past each of N equal slices of [0, 1)) starts
+each uniform's search at most a few steps from its index.  Both compare u with
+the same C as ``np.searchsorted(C, u, side="right")`` and return exactly its
+indices, from the same uniforms drawn in the same order.
 """
 
 from collections.abc import Callable
 
 import numpy as np
+from numba import njit
 
 Resampler = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 
 
-def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
-    """Indices i with ``C_{i-1} <= u < C_i`` for the cumulative weights C.
-
-    C is divided by its last entry so that it ends at exactly 1.0 and a
-    zero-weight particle (a flat step of C) can never be selected.
-    """
+def cumulative_weights(weights: np.ndarray) -> np.ndarray:
+    """C, the cumulative weights divided by their last entry so that C ends at exactly 1.0 and a
+    zero-weight particle (a flat step of C) can never be selected."""
     cumulative = np.cumsum(weights)
     cumulative /= cumulative[-1]
-    return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
+    return cumulative
+
+
+def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
+    """Indices i with ``C_{i-1} <= u < C_i`` for the cumulative weights C (:func:`cumulative_weights`)."""
+    return search(cumulative_weights(weights), np.asarray(uniforms, dtype=float))
+
+
+def search(cumulative: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
+    """``np.searchsorted(cumulative, uniforms, side="right")`` as int64, in O(N + K) (:func:`_guided_search`)."""
+    uniforms = np.ascontiguousarray(uniforms, dtype=float)
+    if uniforms.ndim != 1 or not len(cumulative) or not _searchable(cumulative):
+        return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
+    return _guided_search(cumulative, uniforms)
+
+
+@njit(cache=True)
+def _searchable(cumulative):
+    """C is finite and non-decreasing, so the guided search and ``searchsorted`` agree (a NaN
+    C, from NaN weights, is left to ``searchsorted``)."""
+    if not np.isfinite(cumulative[0]):
+        return False
+    for i in range(1, cumulative.size):
+        if not (cumulative[i] >= cumulative[i - 1]) or not np.isfinite(cumulative[i]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _guided_search(cumulative, uniforms):
+    """For each u the first i with C_i > u (len(C) if none), as ``searchsorted(side="right")``.
+
+    A guide table over 4N slices of [0, C_N) gives, for the slice u falls in, an index at or
+    before u's; a forward scan while C_i <= u finds it (each index of C is passed by the
+    uniforms of its own slice only: O(N + K) for K uniforms).  The slice of u is computed in
+    floating point, so the start is stepped back while C_{start - 1} > u (rounding at a slice's
+    edge); the answer is then exact whatever the rounding.
+    """
+    n, k = cumulative.size, uniforms.size
+    out = np.empty(k, np.int64)
+    top = cumulative[n - 1]
+    slices = 4 * n  # a few slices per index: most uniforms need no step or one
+    guide = np.empty(slices + 1, np.int64)
+    i = 0
+    for b in range(slices + 1):  # guide[b]: the first i with C_i > b / slices * top
+        edge = b / slices * top
+        while i < n and cumulative[i] <= edge:
+            i += 1
+        guide[b] = i
+    scale = slices / top if top > 0 else 0.0
+    for j in range(k):
+        u = uniforms[j]
+        if not (u >= 0.0):  # negative (or NaN): below every slice
+            start = 0
+        elif u >= top:
+            start = guide[slices]
+        else:
+            b = int(u * scale)
+            start = guide[min(b, slices)]
+        while start > 0 and cumulative[start - 1] > u:
+            start -= 1
+        if start < n:  # the usual single step, without a branch to mispredict
+            start += cumulative[start] <= u
+        while start < n and cumulative[start] <= u:
+            start += 1
+        out[j] = start
+    return out
+
+
+@njit(cache=True)
+def _merge_search(cumulative, first, step, n):
+    """Indices of the sorted uniforms u_k = (k + first) / n (systematic) for k < n: one pass of a
+    merge of u and C, the uniforms made on the fly as numpy makes them."""
+    out = np.empty(n, np.int64)
+    size = cumulative.size
+    i = 0
+    for k in range(n):
+        u = (k + first) / step
+        while i < size and cumulative[i] <= u:
+            i += 1
+        out[k] = i
+    return out
+
+
+@njit(cache=True)
+def _stratified_uniforms(offsets, n):
+    """(k + U_k) / n for k < n, as numpy's ``(np.arange(n) + U) / n``."""
+    out = np.empty(offsets.size)
+    for k in range(offsets.size):
+        out[k] = (k + offsets[k]) / n
+    return out
+
+
+@njit(cache=True)
+def _is_sorted(values):
+    for i in range(1, values.size):
+        if not (values[i] >= values[i - 1]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _merge_sorted(cumulative, uniforms):
+    """``searchsorted(C, u, side="right")`` for sorted u: one merge pass."""
+    out = np.empty(uniforms.size, np.int64)
+    i = 0
+    for k in range(uniforms.size):
+        while i < cumulative.size and cumulative[i] <= uniforms[k]:
+            i += 1
+        out[k] = i
+    return out
 
 
 def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None = None) -> np.ndarray:
@@ -32,13 +148,21 @@ def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None 
 def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """One uniform in each stratum ``[k/N, (k+1)/N)`` (Kitagawa, 1996)."""
     n = len(weights)
-    return inverse_cdf(weights, (np.arange(n) + rng.random(n)) / n)
+    cumulative = cumulative_weights(weights)
+    uniforms = _stratified_uniforms(rng.random(n), n)
+    if not _searchable(cumulative) or not _is_sorted(uniforms):
+        return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
+    return _merge_sorted(cumulative, uniforms)
 
 
 def systematic(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """A single uniform shared by all strata: ``u_k = (k + U) / N`` (Carpenter et al., 1999)."""
     n = len(weights)
-    return inverse_cdf(weights, (np.arange(n) + rng.random()) / n)
+    cumulative = cumulative_weights(weights)
+    first = rng.random()
+    if not _searchable(cumulative):
+        return np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right").astype(np.int64)
+    return _merge_search(cumulative, first, n, n)
 
 
 def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:

@@ -17,15 +17,28 @@ h = sqrt(hx^2 + hy^2), the half-diagonal; ``uniform`` weights every point
 alike.  Sample points outside the image are dropped (the box is clipped); a
 box with no sample inside gets an all-zero histogram, which the likelihood
 turns into -inf.
+
+The likelihood's hot path, :meth:`ColourHistogram.bhattacharyya`, is a compiled
+kernel (:func:`_bhattacharyya_kernel`) that reads each box's sample points and
+accumulates its weighted histogram and Bhattacharyya sum in one pass, without
+the (N, K) maps and (N, B) tallies of the vectorised numpy path (still there as
+:meth:`ColourHistogram.bhattacharyya_numpy`, the reference the kernel is tested
+against).  It picks the same pixels (float32 coordinates rounded half to even,
+as ``cv2.remap``'s nearest neighbour does) and adds the same weights in the same
+order per bin, so the counts are bit-identical; only the final dot product's
+order of summation differs from BLAS's (about 1e-16).
 """
 
+import weakref
 from dataclasses import dataclass
 from functools import lru_cache
 
 import cv2
 import numpy as np
+from numba import njit, uint64
 
 KERNELS = ("epanechnikov", "diagonal", "uniform")
+GROUP = 8  # boxes the compiled kernel reads side by side (see _bhattacharyya_kernel; its fast path spells out 8)
 BLOCK_SAMPLES = 100_000  # sample points per bincount: big enough to amortise the calls, small enough for cache
 
 
@@ -47,6 +60,18 @@ def hsv_bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
         raise ValueError(f"at most 256 bins per channel, got {bins}")
     terms = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(tuple(bins)))
     return cv2.transform(terms, _SUM_CHANNELS)
+
+
+_LARGEST_BIN: list = [None, 0]  # (weak reference to) the last bin image checked, and its largest bin
+
+
+def _largest_bin(image: np.ndarray) -> int:
+    """The largest bin index in ``image``, found once per image (every target's likelihood reads
+    the same frame's bin image; the frame's bin image is not changed in place)."""
+    seen = _LARGEST_BIN[0]
+    if seen is None or seen() is not image:
+        _LARGEST_BIN[:] = weakref.ref(image), int(image.max()) if image.size else 0
+    return _LARGEST_BIN[1]
 
 
 def sample_pattern(kernel: str, grid: tuple[int, int] | None, samples: int | None, rng: np.random.Generator | None):
@@ -94,6 +119,8 @@ class ColourHistogram:
         self._tile = np.empty((0, len(self.weights)))  # the weights of the most boxes asked for at once
         u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
         self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
+        self._runs = _pattern_runs(self.points, None if self.samples is not None else tuple(self.grid))
+        self._program = _pairwise_program(len(self.weights))  # numpy's order of a box's kernel-weight sum
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height."""
@@ -106,8 +133,27 @@ class ColourHistogram:
         """rho[p(box), q] for every box, and whether the box has a sample in the image.
 
         With counts c_u and total T, rho = sum_u sqrt(c_u / T) sqrt(q_u) =
-        (sqrt(c) . sqrt(q)) / sqrt(T): no normalised (N, B) array is formed, and
-        the square root is taken in place over the tally, whose spare column
+        (sqrt(c) . sqrt(q)) / sqrt(T), T being the kernel's weight of the samples
+        inside the image.  One compiled pass over each box's samples
+        (:func:`_bhattacharyya_kernel`); :meth:`bhattacharyya_numpy` is the same
+        computation in numpy.
+        """
+        boxes = np.ascontiguousarray(np.atleast_2d(np.asarray(boxes, dtype=float))[:, :4])
+        image = np.ascontiguousarray(bin_image, dtype=np.uint16)
+        if _largest_bin(image) >= self.n_bins:  # the kernel indexes its histograms by bin, unchecked
+            raise ValueError(f"the bin image has bins up to {_largest_bin(image)}, this histogram {self.n_bins}")
+        us, vs, rows, first_column, last_column, first_sample = self._runs
+        return _bhattacharyya_kernel(
+            image, boxes, us, vs, rows, first_column, last_column, first_sample, self.weights,
+            self._one_minus_v2[0], self._u2_minus_v2[0], self.kernel == "diagonal", self._total_weight,
+            self._program, np.sqrt(np.asarray(reference, dtype=float)[: self.n_bins]),
+        )
+
+    def bhattacharyya_numpy(self, bin_image: np.ndarray, boxes: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bhattacharyya` by ``cv2.remap`` and ``np.bincount`` over blocks of boxes (the path
+        before the compiled kernel, kept as its reference).
+
+        The square root is taken in place over the tally, whose spare column
         (points outside the image) meets a zero in sqrt(q).  T is the kernel's
         whole weight less that spare column.
         """
@@ -172,3 +218,238 @@ class ColourHistogram:
         n, width = len(bins), self.n_bins + 1
         index = bins + width * np.arange(n, dtype=np.intp)[:, None]
         return np.bincount(index.ravel(), weights=weights.ravel(), minlength=n * width).reshape(n, width)
+
+
+def _pattern_runs(points: np.ndarray, grid: tuple[int, int] | None):
+    """The sample pattern as runs for :func:`_bhattacharyya_kernel`: the distinct normalised
+    column and row positions (float32, as ``gather`` uses them) and, per run of samples on one row
+    at consecutive columns, its row, first and last + 1 column and first sample.
+
+    A grid's kept points (row-major, the epanechnikov ellipse cutting the corners) form one run per
+    row; sampled points each form their own run, column and row.
+    """
+    if grid is None:
+        k = len(points)
+        index = np.arange(k)
+        us, vs, columns, rows = points[:, 0], points[:, 1], index, index
+    else:
+        gw, gh = grid
+        us = (np.arange(gw) + 0.5) / gw * 2.0 - 1.0
+        vs = (np.arange(gh) + 0.5) / gh * 2.0 - 1.0
+        columns = np.rint((points[:, 0] + 1.0) / 2.0 * gw - 0.5).astype(np.int64)
+        rows = np.rint((points[:, 1] + 1.0) / 2.0 * gh - 0.5).astype(np.int64)
+        if not (np.array_equal(us[columns], points[:, 0]) and np.array_equal(vs[rows], points[:, 1])):
+            raise AssertionError("a grid point is not on the grid")  # cannot happen: sample_pattern's meshgrid
+    starts = np.flatnonzero(np.r_[True, (rows[1:] != rows[:-1]) | (columns[1:] != columns[:-1] + 1)])
+    ends = np.r_[starts[1:], len(points)]
+    return (us.astype(np.float32), vs.astype(np.float32), rows[starts].astype(np.int64),
+            columns[starts].astype(np.int64), (columns[starts] + ends - starts).astype(np.int64), starts.astype(np.int64))
+
+
+def _pairwise_program(n: int) -> np.ndarray:
+    """numpy's order of summation of n values (pairwise: halves, cut at multiples of 8, down to
+    blocks of at most 128) as a postfix program of rows (start, size): a block to sum, or
+    (0, -1), add the last two sums.  Built once per pattern, so the compiled kernel needs no
+    recursion (a recursive function compiled with ``cache=True`` crashed numba when loaded back)."""
+    program = []
+
+    def visit(start, size):
+        if size <= 128:
+            program.append((start, size))
+            return
+        half = size // 2
+        half -= half % 8
+        visit(start, half)
+        visit(start + half, size - half)
+        program.append((0, -1))
+
+    visit(0, n)
+    return np.array(program, dtype=np.int64).reshape(-1, 2)
+
+
+@njit(cache=True)
+def _weight(weights, one_minus_v2, u2_minus_v2, share, k):
+    """Sample k's kernel weight: the fixed kernel's (``share`` = -1), or the diagonal kernel's
+    1 - v^2 - share (u^2 - v^2) with share = w^2 / (w^2 + h^2), as ``gather`` computes it."""
+    return weights[k] if share < 0 else one_minus_v2[k] - share * u2_minus_v2[k]
+
+
+@njit(cache=True)
+def _block_sum(weights, one_minus_v2, u2_minus_v2, share, start, n):
+    """numpy's sum of at most 128 values: one by one under 8, else 8 running sums and a tail."""
+    if n < 8:
+        total = -0.0
+        for i in range(start, start + n):
+            total += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
+        return total
+    r0 = _weight(weights, one_minus_v2, u2_minus_v2, share, start)
+    r1 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 1)
+    r2 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 2)
+    r3 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 3)
+    r4 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 4)
+    r5 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 5)
+    r6 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 6)
+    r7 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 7)
+    i = start + 8
+    end = start + n - n % 8
+    while i < end:
+        r0 += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
+        r1 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 1)
+        r2 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 2)
+        r3 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 3)
+        r4 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 4)
+        r5 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 5)
+        r6 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 6)
+        r7 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 7)
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < start + n:
+        total += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
+        i += 1
+    return total
+
+
+@njit(cache=True)
+def _pairwise_sum(weights, one_minus_v2, u2_minus_v2, share, program, stack):
+    """The sum of a box's kernel weights in numpy's order (``program``, from
+    :func:`_pairwise_program`), so that it equals ``ndarray.sum`` of them to the last bit."""
+    depth = 0
+    for p in range(program.shape[0]):
+        if program[p, 1] < 0:
+            depth -= 1
+            stack[depth - 1] = stack[depth - 1] + stack[depth]
+        else:
+            stack[depth] = _block_sum(weights, one_minus_v2, u2_minus_v2, share, program[p, 0], program[p, 1])
+            depth += 1
+    return stack[0]
+
+
+@njit(cache=True)
+def _pixel_offsets(boxes, b, us, vs, width, height, column, g, row):
+    """Pixel column (or -1 outside the image) of each pattern column of box b, into
+    ``column[i * GROUP + g]``, and row offset (row * width, or -1) of each pattern row, into
+    ``row[j]``: ``gather``'s float32 arithmetic and ``cv2.remap``'s rounding to nearest, half to
+    even.  Whether every one is inside the image."""
+    half, two = np.float32(0.5), np.float32(2.0)
+    ox, oy = np.float32(boxes[b, 0]) - half, np.float32(boxes[b, 1]) - half
+    hw, hh = np.float32(boxes[b, 2]) / two, np.float32(boxes[b, 3]) / two
+    inside = True
+    for i in range(us.size):
+        x = np.rint(ox + us[i] * hw)
+        if x >= 0 and x <= width - 1:
+            column[i * GROUP + g] = np.int64(x)
+        else:
+            column[i * GROUP + g], inside = -1, False
+    for j in range(vs.size):
+        y = np.rint(oy + vs[j] * hh)
+        if y >= 0 and y <= height - 1:
+            row[j] = np.int64(y) * width
+        else:
+            row[j], inside = -1, False
+    return inside
+
+
+@njit(cache=True, error_model="numpy")  # IEEE division: a zero-size diagonal-kernel box gives NaN, as numpy does
+def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column, first_sample, weights,
+                          one_minus_v2, u2_minus_v2, diagonal, total_weight, program, root):
+    """rho and validity of every box: :meth:`ColourHistogram.bhattacharyya` in one pass per box.
+
+    Boxes are read ``GROUP`` (8) at a time, side by side, each into its own histogram,
+    interleaved (``hist[bin * GROUP + box]``): an update of a bin waits on the previous update of
+    that bin, and neighbouring pixels mostly share a bin, so eight independent histograms keep
+    the processor busy where one would wait.  A group whose samples all lie inside the image
+    takes that fast path; otherwise each of its boxes is read alone, its samples outside the
+    image going to a spare bin.  Each bin gets its weights in the order of the samples, as
+    ``np.bincount`` adds them, and the diagonal kernel's total is summed in numpy's order, so
+    the counts and totals are bit-identical to the numpy path's; only the touched bins are
+    square-rooted and reset.
+    """
+    height, width = image.shape
+    flat = image.ravel()
+    n, n_bins = boxes.shape[0], root.size
+    rho, valid = np.zeros(n), np.zeros(n, np.bool_)
+    hist = np.zeros((n_bins + 1) * GROUP)
+    column = np.empty(us.size * GROUP, np.int64)
+    row = np.empty((GROUP, vs.size), np.int64)
+    share = np.full(GROUP, -1.0)  # the diagonal kernel's w^2 / (w^2 + h^2) per box; -1: a fixed kernel
+    whole = np.full(GROUP, total_weight)  # the kernel's weight over all the samples of each box
+    stack = np.empty(64)
+    G = uint64(GROUP)
+    for start in range(0, n, GROUP):
+        m = min(GROUP, n - start)
+        fast = m == GROUP
+        for g in range(m):
+            b = start + g
+            if not _pixel_offsets(boxes, b, us, vs, width, height, column, g, row[g]):
+                fast = False
+            if diagonal:  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
+                share[g] = boxes[b, 2] ** 2 / (boxes[b, 2] ** 2 + boxes[b, 3] ** 2)
+                whole[g] = _pairwise_sum(weights, one_minus_v2, u2_minus_v2, share[g], program, stack)
+        if fast and not diagonal:
+            for r in range(rows.size):
+                j = rows[r]
+                shift = uint64(first_sample[r] - first_column[r])
+                y0, y1, y2, y3 = uint64(row[0, j]), uint64(row[1, j]), uint64(row[2, j]), uint64(row[3, j])
+                y4, y5, y6, y7 = uint64(row[4, j]), uint64(row[5, j]), uint64(row[6, j]), uint64(row[7, j])
+                for i in range(first_column[r], last_column[r]):
+                    c = uint64(i) * G
+                    w = weights[uint64(i) + shift]
+                    hist[uint64(flat[y0 + uint64(column[c])]) * G] += w
+                    hist[uint64(flat[y1 + uint64(column[c + uint64(1)])]) * G + uint64(1)] += w
+                    hist[uint64(flat[y2 + uint64(column[c + uint64(2)])]) * G + uint64(2)] += w
+                    hist[uint64(flat[y3 + uint64(column[c + uint64(3)])]) * G + uint64(3)] += w
+                    hist[uint64(flat[y4 + uint64(column[c + uint64(4)])]) * G + uint64(4)] += w
+                    hist[uint64(flat[y5 + uint64(column[c + uint64(5)])]) * G + uint64(5)] += w
+                    hist[uint64(flat[y6 + uint64(column[c + uint64(6)])]) * G + uint64(6)] += w
+                    hist[uint64(flat[y7 + uint64(column[c + uint64(7)])]) * G + uint64(7)] += w
+        elif fast:  # the same with each box's own diagonal-kernel weights
+            s0, s1, s2, s3, s4, s5, s6, s7 = share[0], share[1], share[2], share[3], share[4], share[5], share[6], share[7]
+            for r in range(rows.size):
+                j = rows[r]
+                shift = uint64(first_sample[r] - first_column[r])
+                y0, y1, y2, y3 = uint64(row[0, j]), uint64(row[1, j]), uint64(row[2, j]), uint64(row[3, j])
+                y4, y5, y6, y7 = uint64(row[4, j]), uint64(row[5, j]), uint64(row[6, j]), uint64(row[7, j])
+                for i in range(first_column[r], last_column[r]):
+                    c = uint64(i) * G
+                    a, d = one_minus_v2[uint64(i) + shift], u2_minus_v2[uint64(i) + shift]
+                    hist[uint64(flat[y0 + uint64(column[c])]) * G] += a - s0 * d
+                    hist[uint64(flat[y1 + uint64(column[c + uint64(1)])]) * G + uint64(1)] += a - s1 * d
+                    hist[uint64(flat[y2 + uint64(column[c + uint64(2)])]) * G + uint64(2)] += a - s2 * d
+                    hist[uint64(flat[y3 + uint64(column[c + uint64(3)])]) * G + uint64(3)] += a - s3 * d
+                    hist[uint64(flat[y4 + uint64(column[c + uint64(4)])]) * G + uint64(4)] += a - s4 * d
+                    hist[uint64(flat[y5 + uint64(column[c + uint64(5)])]) * G + uint64(5)] += a - s5 * d
+                    hist[uint64(flat[y6 + uint64(column[c + uint64(6)])]) * G + uint64(6)] += a - s6 * d
+                    hist[uint64(flat[y7 + uint64(column[c + uint64(7)])]) * G + uint64(7)] += a - s7 * d
+        else:
+            spare = n_bins * GROUP
+            for g in range(m):
+                for r in range(rows.size):
+                    y = row[g, rows[r]]
+                    shift = first_sample[r] - first_column[r]
+                    for i in range(first_column[r], last_column[r]):
+                        w = _weight(weights, one_minus_v2, u2_minus_v2, share[g], i + shift)
+                        x = column[i * GROUP + g]
+                        if y < 0 or x < 0:
+                            hist[spare + g] += w
+                        else:
+                            hist[np.int64(flat[y + x]) * GROUP + g] += w
+        acc = np.zeros(GROUP)  # each box's sum of sqrt(c_u) sqrt(q_u)
+        for u in range(n_bins):  # the group's bins in one pass: a bin is one cache line of its 8 boxes' counts
+            h = u * GROUP
+            either = ((hist[h] + hist[h + 1]) + (hist[h + 2] + hist[h + 3])) + ((hist[h + 4] + hist[h + 5]) + (hist[h + 6] + hist[h + 7]))
+            if either != 0.0:  # the weights are positive (or NaN): a zero sum is eight empty counts
+                for g in range(m):
+                    count = hist[h + g]
+                    if count != 0.0:
+                        acc[g] += np.sqrt(count) * root[u]
+                        hist[h + g] = 0.0
+        for g in range(m):
+            outside = hist[n_bins * GROUP + g]
+            total = whole[g] - outside  # all the kernel's weight but the points outside the image
+            hist[n_bins * GROUP + g] = 0.0
+            if total <= 1e-9 * whole[g]:  # nothing inside, up to rounding
+                total = 0.0
+            s = np.nan if np.isnan(outside) else acc[g]  # a NaN weight outside (zero-size diagonal box): NaN, as numpy's dot
+            rho[start + g] = s / np.sqrt(total if total > 0 else 1.0)
+            valid[start + g] = total > 0
+    return rho, valid

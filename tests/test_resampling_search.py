@@ -1,0 +1,47 @@
+"""The linear-time inverse CDF (issue 18) returns exactly np.searchsorted's indices from the same uniforms."""
+
+import numpy as np
+import pytest
+
+from replication.smc.resampling import RESAMPLERS, cumulative_weights, search
+
+
+def weight_sets(rng):
+    for n in (1, 2, 7, 400, 2000):
+        yield rng.random(n)
+        yield rng.dirichlet(np.ones(n) * 0.05)  # peaked, as after a sharp likelihood
+        one_hot = np.zeros(n)
+        one_hot[rng.integers(n)] = 1.0
+        yield one_hot
+        sparse = rng.random(n) * (rng.random(n) < 0.2)  # flat steps of C: zero weights
+        sparse[-1] += 1e-3
+        yield sparse
+
+
+def test_search_is_searchsorted():
+    rng = np.random.default_rng(0)
+    for weights in weight_sets(rng):
+        cumulative = cumulative_weights(weights)
+        uniforms = np.concatenate([rng.random(3000), [0.0, np.nextafter(1.0, 0.0)], cumulative,
+                                   np.nextafter(cumulative, 0.0), np.nextafter(cumulative, 2.0)])
+        np.testing.assert_array_equal(search(cumulative, uniforms), np.searchsorted(cumulative, uniforms, side="right"))
+    nan = np.array([0.2, np.nan, 1.0])
+    np.testing.assert_array_equal(search(nan, np.array([0.1, 0.5])), np.searchsorted(nan, np.array([0.1, 0.5]), side="right"))
+
+
+@pytest.mark.parametrize("scheme", ["multinomial", "stratified", "systematic"])
+def test_schemes_draw_what_they_drew_before(scheme):
+    """The same stream gives the same indices as the searchsorted form before issue 18."""
+    rng = np.random.default_rng(1)
+    for weights in weight_sets(rng):
+        weights = weights / weights.sum()
+        n, seed = len(weights), int(rng.integers(2**31))
+        before = np.random.default_rng(seed)
+        if scheme == "multinomial":
+            uniforms = before.random(n)
+        elif scheme == "stratified":
+            uniforms = (np.arange(n) + before.random(n)) / n
+        else:
+            uniforms = (np.arange(n) + before.random()) / n
+        expected = np.searchsorted(cumulative_weights(weights), uniforms, side="right")
+        np.testing.assert_array_equal(RESAMPLERS[scheme](weights, np.random.default_rng(seed)), expected)
