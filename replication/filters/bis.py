@@ -29,8 +29,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from replication.smc.loop import FilterOutput, ResamplingPolicy, Summaries
-from replication.smc.resampling import RESAMPLERS, multinomial
+from replication.smc.loop import (
+    FilterOutput,
+    FilterState,
+    ParticleFilter,
+    ResamplingPolicy,
+    Summaries,
+    model_proposal,
+)
+from replication.smc.resampling import multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
 
 
@@ -178,46 +185,78 @@ class JointFilter:
             del kept[index]
 
 
+@dataclass
+class DistributedState:
+    """The targets of a distributed filter: one :class:`~replication.smc.loop.FilterState` each, sharing ``rng``.
+
+    ``models``, ``particles``, ``log_weights`` and ``records`` are read off the targets' states,
+    as a :class:`JointState` holds them.
+    """
+
+    targets: list[FilterState]
+    rng: np.random.Generator
+    t: int = 0
+
+    @property
+    def models(self) -> list:
+        return [target.model for target in self.targets]
+
+    @property
+    def particles(self) -> list:
+        return [target.particles for target in self.targets]
+
+    @property
+    def log_weights(self) -> list:
+        return [target.log_weights for target in self.targets]
+
+    @property
+    def records(self) -> list[Summaries]:
+        return [target.records for target in self.targets]
+
+    def outputs(self) -> list[FilterOutput]:
+        return [target.records.output(log_evidence=float("nan")) for target in self.targets]
+
+
 class DistributedFilter(JointFilter):
-    """M bootstrap PFs, one per target, whose weights an ``interact`` stage then couples.
+    """M particle filters, one per target, on the one :class:`~replication.smc.loop.ParticleFilter` loop,
+    whose weights an ``interact`` stage couples between the loop's two halves.
 
-    Each frame every target resamples from its weights, moves by its own
-    motion and is weighted by its own likelihood pi (bis_pf's step 1, and the
-    starting point of MFMC and DMOT); ``interact(particles, pi, state)``
-    returns each target's final normalised weights.
-
-    The per-target step is not the :class:`~replication.smc.loop.ParticleFilter`
-    loop: the targets share one random stream, and each resamples from its
-    *interacted* weights at the start of the next step (resample i, move i, for
-    every i, then interact), where the loop resamples at the end of its own
-    step from the likelihood weights; the loop also weights by the carried
-    log-weights plus the log-likelihood (equal only up to rounding to the
-    likelihood alone after resampling) and recovers a degenerate step from the
-    normalised predicted weights rather than exactly 1/N.  Running it on the
-    loop would change every number of bis_pf; the resampling scheme at least is
-    the loop's policy (``resampling``: multinomial, every step).
+    Each frame every target's filter proposes from its model (the motion prior, or a proposal
+    fusing detections) and is weighted by its own likelihood: pi (bis_pf's step 1, and the
+    starting point of MFMC and DMOT); ``interact(particles, pi, state)`` returns each target's
+    final normalised weights, from which the loop records the estimate and resamples
+    (``resampling``: multinomial every step, as bis_pf's step 1 resamples every frame).  The
+    targets share one random stream.
     """
 
     resampling = ResamplingPolicy("multinomial", 1.0)
 
-    def step(self, state: JointState, z) -> None:
-        rng, n = state.rng, self.n_particles
-        resample = RESAMPLERS[self.resampling.scheme]
+    @property
+    def loop(self) -> ParticleFilter:
+        return ParticleFilter(self.n_particles, self.resampling, proposal=model_proposal)
+
+    def start(self, models: list, rng: np.random.Generator) -> DistributedState:
+        state = DistributedState([], rng)
+        for model in models:
+            self.add(state, model)
+        return state
+
+    def add(self, state: DistributedState, model) -> None:
+        """A target is born at the state's step: its filter starts from ``model``'s prior."""
+        target = self.loop.start(model, state.rng)
+        target.t = state.t
+        state.targets.append(target)
+
+    def remove(self, state: DistributedState, index: int) -> None:
+        del state.targets[index]
+
+    def step(self, state: DistributedState, z) -> None:
+        loop = self.loop
         state.t += 1
-        proposed, local, degenerate = [], [], []
-        for i, model in enumerate(state.models):
-            ancestors = resample(np.exp(state.log_weights[i]), rng)
-            particles, log_correction = model.propose(state.particles[i][ancestors], state.t, rng)
-            try:
-                pi, _ = normalise(model.log_likelihood(particles, z, state.t) + log_correction)
-                degenerate.append(False)
-            except DegenerateWeightsError:  # nothing seen: the prediction stands
-                pi = np.full(n, 1.0 / n)
-                degenerate.append(True)
-            proposed.append(particles)
-            local.append(pi)
-        for i, (particles, weights) in enumerate(zip(proposed, self.interact(proposed, local, state))):
-            state.record(i, particles, weights, degenerate[i])
+        weighed = [loop.weigh(target, z) for target in state.targets]
+        final = self.interact([w.particles for w in weighed], [w.weights for w in weighed], state)
+        for target, w, weights in zip(state.targets, weighed, final):
+            loop.conclude(target, w.reweighted(weights))
 
 
 @dataclass

@@ -66,6 +66,13 @@ def prior_proposal(model, particles, log_weights, t, rng):
     return model.propagate(particles, t, rng), log_weights
 
 
+def model_proposal(model, particles, log_weights, t, rng):
+    """The model's own proposal (``model.propose``: x_t and log p(x_t | x_{t-1}) / q), e.g. one fusing
+    detections (:mod:`replication.models.boosted`); the bootstrap proposal for a model whose q is its prior."""
+    moved, log_correction = model.propose(particles, t, rng)
+    return moved, log_weights + log_correction
+
+
 @dataclass(frozen=True)
 class ResamplingPolicy:
     """Resample with ``scheme`` whenever ``ESS < ess_threshold * N``; a threshold of 1 means every step."""
@@ -173,14 +180,18 @@ class ParticleFilter:
         return FilterState(model, rng, model.sample_initial(n, rng), np.full(n, -np.log(n)))
 
     def step(self, state: FilterState, z) -> None:
-        """Propose, move, weight, estimate and maybe resample for the next observation z_t.
+        """Propose, move, weight, estimate and maybe resample for the next observation z_t."""
+        self.conclude(state, self.weigh(state, z))
+
+    def weigh(self, state: FilterState, z) -> "Weighed":
+        """The first half of a step: propose, move and weight for z_t; the state only advances its t.
 
         A step where every log-weight is -inf (no particle explains z_t) is
         recovered by keeping the predicted weights (those before the
         likelihood), as if z_t had carried no information; it is flagged in
         ``FilterOutput.degenerate`` (log_evidence then gets the predicted mass only).
         """
-        model, rng, n = state.model, state.rng, self.n_particles
+        model, rng = state.model, state.rng
         state.t += 1
         t = state.t
         particles, log_weights = self.proposal(model, state.particles, state.log_weights, t, rng)
@@ -197,11 +208,30 @@ class ParticleFilter:
             weights, log_total = normalise(predicted)
             degenerate = True
         state.log_evidence += log_total
-        log_weights = log_weights - log_total
-        state.records.add(particles, weights, degenerate)
+        return Weighed(particles, weights, log_weights - log_total, degenerate)
+
+    def conclude(self, state: FilterState, weighed: "Weighed") -> None:
+        """The second half: record the estimate of the weighted particles, then resample if the policy wants."""
+        n, particles, log_weights = self.n_particles, weighed.particles, weighed.log_weights
+        state.records.add(particles, weighed.weights, weighed.degenerate)
         do_resample = self.resampling.wants(state.records.ess[-1], n)
         if do_resample:
-            particles = particles[RESAMPLERS[self.resampling.scheme](weights, rng)]
+            particles = particles[RESAMPLERS[self.resampling.scheme](weighed.weights, state.rng)]
             log_weights = np.full(n, -np.log(n))
         state.records.resampled.append(do_resample)
         state.particles, state.log_weights = particles, log_weights
+
+
+@dataclass
+class Weighed:
+    """A step's weighted particles before resampling: normalised ``weights`` and their logs."""
+
+    particles: np.ndarray
+    weights: np.ndarray
+    log_weights: np.ndarray
+    degenerate: bool
+
+    def reweighted(self, weights: np.ndarray) -> "Weighed":
+        """The same particles under other normalised weights (a multi-target interaction's)."""
+        with np.errstate(divide="ignore"):
+            return Weighed(self.particles, weights, np.log(weights), self.degenerate)
