@@ -213,3 +213,12 @@ def test_scale_changes_lists_what_quick_changes_from_the_config():
     assert scale_changes(config) == ["runs: 100 -> 10", "scene Girl last frame: all -> 100"]
     assert scale_note("paper") is None
     assert "(runs: 100 -> 10)" in scale_note("quick", ["runs: 100 -> 10"])
+
+
+def test_every_template_escapes_what_a_config_puts_in_a_page():
+    """A title, label or note from a config is text: a <script> in it must not reach the page as markup."""
+    from replication.report.render import ENVIRONMENT, render
+
+    assert all(ENVIRONMENT.autoescape(name) for name in ENVIRONMENT.list_templates())
+    page = render("base.html.j2", title="<script>alert(1)</script>")
+    assert "<script>alert(1)" not in page and "&lt;script&gt;alert(1)" in page
