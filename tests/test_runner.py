@@ -52,6 +52,30 @@ def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):
     assert not (tmp_path / "experiments").exists()  # no work started
 
 
+@pytest.mark.parametrize(
+    "args, expected",
+    [
+        (("--help",), "experiment: bis_pf, "),  # the experiments and the main settings, in a page
+        (("experiment=bis_pf", "--help"), "Main settings"),
+        (("--cfg", "job"), "base_seed: 20261121"),
+        (("--info", "searchpath"), "Config search path"),
+        (("--version",), "replication 0.1.0"),
+    ],
+)
+def test_hydra_flags_describe_the_app_without_an_experiment(args, expected):
+    result = subprocess.run([sys.executable, "-m", "replication", *args], cwd=PROJECT_ROOT, capture_output=True,
+                            text=True, timeout=60, check=False)
+    assert result.returncode == 0, result.stderr
+    assert expected in result.stdout
+    assert len(result.stdout.splitlines()) < 60
+
+
+def test_the_report_command_prints_its_usage():
+    result = subprocess.run([sys.executable, "-m", "replication.report", "--help"], cwd=PROJECT_ROOT,
+                            capture_output=True, text=True, timeout=60, check=False)
+    assert result.returncode == 0 and "rebuild reports from stored runs only" in result.stdout, result.stderr
+
+
 def test_expansion_is_method_by_condition_by_repetition(make_cfg):
     runs = expand(make_cfg("gps_qmcpf", *SMALL))
     assert len(runs) == (5 * 3 + 1) * 3  # five filters at N = 500, 200, 100 and the grid, 3 repetitions each

@@ -29,6 +29,9 @@ OPTIONS = ("sweep", "metric")  # ours too: name=text
 
 
 def main(argv: list[str]) -> None:
+    if {"--help", "-h"} & set(argv):
+        print(__doc__.strip())
+        return
     chosen = [a.split("=", 1)[1].split(",") for a in argv if a.startswith("experiment=")]
     names = chosen[-1] if chosen else experiment_names()
     switches = dict(SWITCHES)

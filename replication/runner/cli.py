@@ -15,6 +15,7 @@ import sys
 import hydra
 from omegaconf import DictConfig
 
+from replication import __version__
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.runner.config import ConfigError, Run
 from replication.runner.execute import BackendError, execute
@@ -27,10 +28,16 @@ def fail(message: str) -> None:
     raise SystemExit(2)
 
 
+HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
+
+
 def check_experiment_argument(argv: list[str]) -> None:
-    """Catch a missing or unknown ``experiment=`` before Hydra turns it into a traceback."""
+    """Catch a missing or unknown ``experiment=`` before Hydra turns it into a traceback (Hydra's own
+    flags, which describe the app rather than run it, need none)."""
     known = experiment_names()
     chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
+    if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
+        return
     if not chosen:
         fail(f"name an experiment: python -m replication experiment=<name>; known: {', '.join(known)}")
     for name in chosen[-1].split(","):
@@ -149,6 +156,9 @@ def main() -> None:
         os.environ["PYTHONWARNINGS"] = ",".join(filter(None, [os.environ.get("PYTHONWARNINGS"), QUIET_CHILDREN]))
     try:
         argv = sys.argv[1:]
+        if "--version" in argv:
+            print(f"replication {__version__}")
+            return
         check_experiment_argument(argv)
         check_overrides(argv)
         run_experiment()
