@@ -189,3 +189,17 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
                if isinstance(item, list)]
     assert entries == [[("Table 1: a long one", 0), ("Figure 1", n - 2)], [("Figure 2", n - 1)]]
     assert reader.get_destination_page_number(sections[1]) == n - 1
+
+
+def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
+    import pandas as pd
+
+    import replication.report.figures as figures
+
+    records = pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]})
+    with pytest.raises(ValueError, match="no runs at conditions"):
+        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")
+    seen = []
+    monkeypatch.setattr(figures, "_figures", lambda: {"probe": lambda r, s, e, p: seen.append(sorted(r["condition"])) or p})
+    figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")
+    assert seen == [["scene=b"]]

@@ -220,10 +220,15 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
 
     A spec that names a ``paper_table`` gets the published values: ``published``,
     else those of ``conf/config.yaml``'s ``published_values`` (none if that file is missing).
+    A spec with ``conditions: [..]`` draws the runs of those conditions only.
     """
     figures = _figures()
     if spec["kind"] not in figures:
         raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(figures)}")
+    if "conditions" in spec:
+        records = records[records["condition"].isin(spec["conditions"])]
+        if records.empty:
+            raise ValueError(f"figure {spec.get('name', spec['kind'])!r}: no runs at conditions {spec['conditions']}")
     if "paper_table" not in spec:
         return figures[spec["kind"]](records, spec, experiment, path)
     if published is None:
