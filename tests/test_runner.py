@@ -257,6 +257,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
     result = cli("-m", "experiment=ungm_horizon", *settings, "experiment.methods.grid.n_points=201,1601")
     assert result.returncode == 0, result.stderr
     assert "9 runs computed, 0 already stored" in result.stdout and "3 runs computed, 6 already stored" in result.stdout
+    assert list((tmp_path / "experiments" / "multirun").glob("*/multirun.yaml"))  # Hydra's record, under the store
     report = subprocess.run(
         [sys.executable, "-m", "replication.report", "experiment=ungm_horizon", *settings, f"store={tmp_path / 'experiments'}",
          f"reports={tmp_path / 'reports'}", "sweep=experiment.methods.grid.n_points=201,1601,3201", "metric=rmse"],
