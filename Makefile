@@ -2,6 +2,7 @@
 # make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine (reports/benchmark/)
+# make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -10,11 +11,15 @@ BIN := $(VENV)/bin
 SCALE ?= quick
 JOBS ?= 2
 EXPERIMENTS := $(sort $(basename $(notdir $(wildcard conf/experiment/*.yaml))))
+READINGS := $(sort $(basename $(notdir $(wildcard conf/experiment/*_readings.yaml))))
+# The multiverses run with make replicate at the quick scale (a small design each); at paper scale
+# their Sobol designs take hours, so they are make readings SCALE=paper's.
+REPLICATE := $(if $(filter paper,$(SCALE)),$(filter-out $(READINGS),$(EXPERIMENTS)),$(EXPERIMENTS))
 comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-all replicate report benchmark
+.PHONY: setup browser test test-all replicate readings report benchmark
 
 setup: $(VENV)/.installed
 
@@ -40,8 +45,12 @@ test-all: setup browser
 # One Hydra multirun over every experiment: one process and one pool of workers for all of them,
 # instead of starting Python, numba and the workers again per experiment (about two minutes at quick scale).
 replicate: setup
-	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(EXPERIMENTS)) scale=$(SCALE) n_jobs=$(JOBS)
+	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
 	$(BIN)/python benchmarks/benchmark.py
+	$(BIN)/python -m replication.report.pdf
+
+readings: setup
+	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(READINGS)) scale=$(SCALE) n_jobs=$(JOBS)
 	$(BIN)/python -m replication.report.pdf
 
 benchmark: setup
