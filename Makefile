@@ -27,6 +27,10 @@ $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	# TrackEval (HOTA) pulls in opencv-python beside opencv-python-headless; both unpack into cv2/.
+	# Reinstalling the headless build last makes its cv2 the one imported (no libGL or X11 needed).
+	$(BIN)/python -m pip install --quiet --force-reinstall --no-deps \
+		"opencv-python-headless==$$($(BIN)/python -c 'import importlib.metadata as m; print(m.version("opencv-python-headless"))')"
 	touch $@
 
 # The report's headless-browser test uses Debian's chromium: installed here when apt-get
