@@ -222,3 +222,23 @@ def test_every_template_escapes_what_a_config_puts_in_a_page():
     assert all(ENVIRONMENT.autoescape(name) for name in ENVIRONMENT.list_templates())
     page = render("base.html.j2", title="<script>alert(1)</script>")
     assert "<script>alert(1)" not in page and "&lt;script&gt;alert(1)" in page
+
+
+def test_a_summary_table_is_written_as_numbers_and_read_back_to_the_same_page():
+    """summary tables (issue 19): the CSV has each metric's mean, low and high as numbers; the page and
+    the PDF (drawn from the CSV) show 'mean [low, high]'."""
+    import io
+
+    import pandas as pd
+
+    from replication.report.tables import Table, TableKind
+
+    records = pd.DataFrame({"method": ["A"] * 6 + ["B"] * 6, "condition": [""] * 12,
+                            "mota": [0.5, 0.6, 0.55, 0.52, 0.58, 0.61, 0.1, 0.2, 0.15, 0.12, 0.18, 0.11]})
+    table = TableKind.of({"name": "s", "metrics": ["mota"]}, {"methods": {}}, pd.DataFrame()).build(records)
+    written = table.written()
+    assert list(written.columns) == ["method", "condition", "runs", "mota", "mota_low", "mota_high"]
+    assert pd.api.types.is_float_dtype(written["mota"]) and (written["mota_low"] <= written["mota"]).all()
+    assert written.loc[0, "mota"] == pytest.approx(np.mean([0.5, 0.6, 0.55, 0.52, 0.58, 0.61]))
+    back = Table.read(pd.read_csv(io.StringIO(written.to_csv(index=False))))
+    assert back.shown().equals(table.shown())

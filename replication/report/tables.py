@@ -43,6 +43,8 @@ class Table:
     def shown(self) -> pd.DataFrame:
         """The frame as text for a page: 'mean [low, high]', the paper's value, the verdict."""
         shown = self.frame.drop(columns=["ours", "ci_low", "ci_high", "estimate", "verdict"], errors="ignore")
+        for column in _estimate_columns(shown):
+            shown[column] = [str(e) for e in shown[column]]
         if "estimate" in self.frame:
             shown.insert(3, "ours (95% CI)", [str(e) for e in self.frame["estimate"]])
         if "paper" in shown:
@@ -61,16 +63,31 @@ class Table:
         if {"outcome", "why"} <= set(frame.columns):
             frame["verdict"] = [Verdict(Outcome(o), "" if pd.isna(w) else w) if isinstance(o, str) and o else None
                                 for o, w in zip(frame.pop("outcome"), frame.pop("why"))]
+        for column in [c for c in frame.columns if {f"{c}_low", f"{c}_high"} <= set(frame.columns)]:
+            frame[column] = [Estimate(v, lo, hi, n, "") for v, lo, hi, n in
+                             zip(frame[column], frame.pop(f"{column}_low"), frame.pop(f"{column}_high"), frame["runs"])]
         return cls(frame)
 
     def written(self) -> pd.DataFrame:
-        """The frame for a CSV: numbers as numbers, the verdict as its outcome and why."""
+        """The frame for a CSV: numbers as numbers (a metric's interval in its ``_low`` and ``_high``
+        columns), the verdict as its outcome and why."""
         frame = self.frame.drop(columns=["estimate"], errors="ignore").copy()
+        for column in _estimate_columns(frame):
+            estimates = frame[column]
+            at = frame.columns.get_loc(column)
+            frame[column] = [e.value for e in estimates]
+            frame.insert(at + 1, f"{column}_low", [e.low for e in estimates])
+            frame.insert(at + 2, f"{column}_high", [e.high for e in estimates])
         if "verdict" in frame:
             frame["outcome"] = [v.outcome.value if v else "" for v in frame["verdict"]]
             frame["why"] = [v.why if v else "" for v in frame["verdict"]]
             frame = frame.drop(columns=["verdict"])
         return frame
+
+
+def _estimate_columns(frame: pd.DataFrame) -> list[str]:
+    """The columns of a frame that hold an :class:`Estimate` per row (a summary table's metrics)."""
+    return [c for c in frame.columns if len(frame) and all(isinstance(v, Estimate) for v in frame[c])]
 
 
 def match(theirs: pd.DataFrame, method: str, condition: str, spec: dict) -> pd.DataFrame:
@@ -265,7 +282,8 @@ class Improvement(TableKind):
 
 
 class Summary(TableKind):
-    """Ours only: one row per method and condition, one column per metric, 'mean [95% CI]'."""
+    """Ours only: one row per method and condition, one column per metric: its mean and 95% interval
+    (shown 'mean [low, high]'; in the CSV as the metric's column and its ``_low`` and ``_high``)."""
 
     kind = "summary"
     compares = False
@@ -276,7 +294,7 @@ class Summary(TableKind):
         table = pd.DataFrame({"method": [self.label(m) for m in first["method"]],
                               "condition": [c or "-" for c in first["condition"]], "runs": first["runs"]})
         for metric, summary in columns.items():
-            table[metric] = [str(Estimate(*values, "")) for values in
+            table[metric] = [Estimate(*values, "") for values in
                              zip(summary["mean"], summary["ci_low"], summary["ci_high"], summary["runs"])]
         return Table(table)
 
