@@ -1,6 +1,6 @@
 """``python -m replication experiment=<name> [overrides]``: run an experiment and write its report."""
 
-from replication.runner.cli import main
+from replication.cli import main
 
 if __name__ == "__main__":
     main()

@@ -286,7 +286,8 @@ def test_ball_scenes_per_run_or_fixed(make_cfg, scene_seed):
 def test_a_scene_seed_that_is_neither_is_refused(make_cfg):
     from conftest import SMALL
 
-    from replication.runner.config import ConfigError, expand
+    from replication.errors import ConfigError
+    from replication.runner.config import expand
 
     cfg = make_cfg("bis_pf", *SMALL, "experiment.scenes.exp2_16_targets.scene_seed=per_frame")
     with pytest.raises(ConfigError, match="scene_seed"):

@@ -5,11 +5,12 @@ import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from replication.errors import ConfigError
 from replication.paths import CONF_DIR, experiment_names
 from replication.report.claims import Claim, Reading, load_papers
 from replication.report.multiverse import READING, Case, Robustness, write_multiverse_report
 from replication.report.verdict import Outcome, Verdict
-from replication.runner.config import ConfigError, expand
+from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
 from replication.runner.store import Store

@@ -14,15 +14,15 @@ from pathlib import Path
 import pandas as pd
 import pytest
 from conftest import SMALL
-
-from replication.paths import PROJECT_ROOT
 from joblib import Parallel, delayed
 
-from replication.runner.cli import check_overrides
-from replication.runner.config import ConfigError, expand
+from replication.cli import check_overrides
+from replication.errors import ConfigError
+from replication.paths import PROJECT_ROOT
+from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute, parallel_backend
-from replication.runner.validate import prepare
 from replication.runner.store import Store
+from replication.runner.validate import prepare
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
 INTERRUPTED = re.compile(r"interrupted: (\d+) runs stored, rerun the same command to resume")

@@ -18,8 +18,8 @@ from replication.paths import PROJECT_ROOT
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.provenance import code_digest
-from replication.runner.seeding import seed_sequence
 from replication.runner.store import Store
+from replication.seeding import seed_sequence
 
 
 def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from replication.runner.config import Run
+from replication.run import Run
 from replication.tasks import TASKS
 
 UNGM = {"name": "ungm", "Q": 10.0, "R": 1.0, "x0": 0.1, "P0": 2.0, "steps": 50}

@@ -15,12 +15,12 @@ import sys
 
 from hydra import compose, initialize_config_dir
 
+from replication.errors import ConfigError, fail
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.report.experiment import write_experiment_report
 from replication.report.index import write_index
 from replication.report.multiverse import write_multiverse_report
-from replication.runner.cli import fail
-from replication.runner.config import ConfigError, expand
+from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
 from replication.runner.store import Store
 

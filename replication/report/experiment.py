@@ -12,14 +12,15 @@ from omegaconf import DictConfig, OmegaConf
 
 import replication
 from replication.paths import resolve
-from replication.report.figures import draw
 from replication.report.claims import evaluate
+from replication.report.figures import draw
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
 from replication.report.scale import scale_changes, scale_note
 from replication.report.tables import TableKind
 from replication.report.verdict import RULES, Verdict
-from replication.runner.config import Run, at_scale
+from replication.run import Run
+from replication.runner.config import at_scale
 from replication.runner.store import Store
 
 

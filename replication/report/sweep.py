@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication.report.figures import metric_vs_condition
+from replication.errors import ConfigError
 from replication.report.aggregate import summarise
+from replication.report.figures import metric_vs_condition
 from replication.report.render import html_table, render
-from replication.runner.config import ConfigError
 
 
 def parse_sweep(text: str) -> tuple[str, list[str]]:

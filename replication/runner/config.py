@@ -15,63 +15,18 @@ before any work starts, and errors are one line that names the bad key.
 import hashlib
 import itertools
 import json
-from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from replication.filters import FILTERS
+from replication.errors import ConfigError
+from replication.filters import FILTERS, build_filter
+from replication.run import Run
 from replication.runner.provenance import code_digest
-from replication.runner.seeding import seed_sequence
+from replication.tasks import TASKS, DataMissing
 
 SCALES = ("paper", "quick")
 SHORT_NAMES = {"n_particles": "N", "steps": "T", "n_joint": "K"}
-
-
-class ConfigError(ValueError):
-    """A config that cannot run; the message is meant for the user as is."""
-
-
-@dataclass(frozen=True)
-class Run:
-    """One independent run: the pure input of a task."""
-
-    experiment: str
-    task: str
-    method: str
-    condition: str
-    repetition: int
-    model: dict[str, Any]
-    method_params: dict[str, Any]
-    base_seed: int
-    key: str
-    data_condition: str = ""
-
-    @property
-    def run_id(self) -> str:
-        condition = self.condition or "default"
-        return f"{self.method}__{condition}__{self.key}__r{self.repetition:03d}"
-
-    def rng(self, stream: str) -> np.random.Generator:
-        """Independent generators: ``data`` is shared by every method at the same model
-        condition and repetition (common random numbers); ``filter`` is the method's own."""
-        if stream == "data":
-            identity = ("data", self.data_condition, self.repetition)
-        else:
-            identity = (stream, self.method, self.condition, self.repetition)
-        return np.random.default_rng(seed_sequence(self.base_seed, *identity))
-
-    def identity(self) -> dict[str, Any]:
-        return {
-            "experiment": self.experiment,
-            "method": self.method,
-            "condition": self.condition,
-            "data_condition": self.data_condition,
-            "repetition": self.repetition,
-            "run_key": self.key,
-            "run_id": self.run_id,
-        }
 
 
 def _label(name: str, value: Any) -> str:
@@ -126,8 +81,6 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     Conditions whose data are absent (a real sequence not on this machine) are
     left out, with a message appended to ``skipped``.
     """
-    from replication.tasks import TASKS, DataMissing
-
     exp = cfg.experiment
     repetitions = n_runs(cfg)
     if exp.get("task") not in TASKS:
@@ -186,10 +139,4 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     return runs
 
 
-def build_filter(method: str, params: dict[str, Any], condition: str = ""):
-    kwargs = {k: v for k, v in params.items() if k not in ("filter", "label")}
-    try:
-        return FILTERS[params["filter"]](**kwargs)
-    except (TypeError, ValueError) as error:
-        where = f" at {condition}" if condition else ""
-        raise ConfigError(f"method {method!r}{where}: {error}") from None
+

@@ -20,14 +20,14 @@ import sys
 import threading
 import time
 import warnings
+from collections.abc import Iterator
 from contextlib import closing, contextmanager
-from typing import Iterator
 
 from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
 import replication
-from replication.runner.config import Run
+from replication.run import Run
 from replication.runner.memory import retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise

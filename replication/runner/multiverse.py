@@ -32,8 +32,10 @@ from hydra.core.global_hydra import GlobalHydra
 from omegaconf import DictConfig, OmegaConf
 from scipy.stats import qmc
 
+from replication.errors import ConfigError
 from replication.paths import CONF_DIR, experiment_names
-from replication.runner.config import ConfigError, Run, at_scale
+from replication.run import Run
+from replication.runner.config import at_scale
 from replication.runner.validate import prepare
 
 NAME = re.compile(r"[a-z][a-z0-9_]*")

@@ -15,7 +15,8 @@ import pandas as pd
 from hydra import compose, initialize_config_dir
 
 from replication.paths import CONF_DIR, resolve
-from replication.runner.config import Run, expand
+from replication.run import Run
+from replication.runner.config import expand
 from replication.runner.store import Store
 
 SERIES = ("per_frame", "strip", "tracks")  # per-frame data, kept in the records

@@ -53,7 +53,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication.runner.config import Run
+from replication.run import Run
 
 REQUIRED_KEYS = (  # written by execute.perform for every task
     "experiment", "method", "condition", "data_condition", "repetition", "run_key", "run_id",

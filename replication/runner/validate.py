@@ -12,8 +12,10 @@ import typing
 
 from omegaconf import DictConfig, OmegaConf
 
+from replication.errors import ConfigError
 from replication.paths import resolve
-from replication.runner.config import ConfigError, Run, at_scale, expand
+from replication.run import Run
+from replication.runner.config import at_scale, expand
 from replication.runner.execute import BackendError, check_backend
 
 RESERVED_METHOD_KEYS = ("filter", "label", "sweep", "only", "observation")  # read by expand, not by the filter

@@ -10,8 +10,8 @@ from pathlib import Path
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from replication.errors import fail
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.runner.cli import fail
 from replication.scenes.export import write_sequence
 from replication.scenes.factory import build_sequence
 

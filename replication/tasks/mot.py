@@ -21,13 +21,14 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
+from replication.filters import build_filter
 from replication.filters.bis import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator
 from replication.metrics.hota import hota
 from replication.metrics.mot import BOX, clear_mot_matches, matched_centre_error, mot_metrics
 from replication.models.boosted import BoostedBoxModel
-from replication.runner.config import Run, build_filter
+from replication.run import Run
 from replication.scenes.mot import MOT_ROOT, load_mot
 from replication.tasks.tracking import histogram_args
 from replication.vision.colour import ColourLikelihood

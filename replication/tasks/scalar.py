@@ -2,9 +2,10 @@
 
 import time
 
+from replication.filters import build_filter
 from replication.metrics import filter_diagnostics, rmse
 from replication.models import MODELS
-from replication.runner.config import Run, build_filter
+from replication.run import Run
 
 
 def build_model(params: dict):

@@ -13,13 +13,14 @@ JPEG decoding), which the papers' videos did not pay for.
 
 import numpy as np
 
+from replication.filters import build_filter
 from replication.filters.tracker import Adaptation, Marginal
 from replication.filters.tracker import tracker as make_tracker
 from replication.metrics import multi
 from replication.metrics import tracking as tm
 from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
-from replication.runner.config import Run, build_filter
+from replication.run import Run
 from replication.scenes.factory import cached_sequence
 from replication.vision.colour import ColourLikelihood
 from replication.vision.fusion import FusionLikelihood

@@ -16,17 +16,12 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.errors import ConfigError, fail
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.runner.config import ConfigError, Run
+from replication.run import Run
 from replication.runner.execute import BackendError, execute
 from replication.runner.store import Store
 from replication.runner.validate import parallel_settings, prepare
-
-
-def fail(message: str) -> None:
-    print(f"error: {message}", file=sys.stderr)
-    raise SystemExit(2)
-
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
 

@@ -1,0 +1,12 @@
+"""Errors a user can fix, and how the command lines report them: one line on stderr, exit status 2."""
+
+import sys
+
+
+class ConfigError(ValueError):
+    """A config that cannot run; the message is meant for the user as is."""
+
+
+def fail(message: str) -> None:
+    print(f"error: {message}", file=sys.stderr)
+    raise SystemExit(2)
