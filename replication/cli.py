@@ -11,6 +11,7 @@ import re
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import hydra
 from omegaconf import DictConfig
@@ -26,10 +27,22 @@ from replication.runner.validate import parallel_settings, prepare
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
 
 
+def config_dirs(argv: list[str]) -> list[Path]:
+    """The folders Hydra's ``--config-dir`` / ``-cd`` adds to the config search path (a user's own experiments)."""
+    found = []
+    for i, arg in enumerate(argv):
+        if arg.startswith("--config-dir="):
+            found.append(Path(arg.split("=", 1)[1]))
+        elif arg in ("--config-dir", "-cd") and i + 1 < len(argv):
+            found.append(Path(argv[i + 1]))
+    return found
+
+
 def check_experiment_argument(argv: list[str]) -> None:
     """Catch a missing or unknown ``experiment=`` before Hydra turns it into a traceback (Hydra's own
-    flags, which describe the app rather than run it, need none)."""
-    known = experiment_names()
+    flags, which describe the app rather than run it, need none).  Experiments in a ``--config-dir``'s
+    ``experiment/`` folder are known too."""
+    known = experiment_names(*config_dirs(argv))
     chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
     if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
         return

@@ -11,5 +11,6 @@ def resolve(path: str | Path) -> Path:
     return path if path.is_absolute() else PROJECT_ROOT / path
 
 
-def experiment_names() -> list[str]:
-    return sorted(p.stem for p in (CONF_DIR / "experiment").glob("*.yaml"))
+def experiment_names(*config_dirs: Path) -> list[str]:
+    """The experiments of ``conf/experiment/`` and of each extra Hydra config dir's ``experiment/``."""
+    return sorted({p.stem for folder in (CONF_DIR, *config_dirs) for p in (Path(folder) / "experiment").glob("*.yaml")})

@@ -70,6 +70,19 @@ def test_hydra_flags_describe_the_app_without_an_experiment(args, expected):
     assert len(result.stdout.splitlines()) < 60
 
 
+def test_a_users_own_experiment_runs_from_hydras_config_dir(cli, tmp_path):
+    """``--config-dir`` (Hydra's way to add configs) makes a user's ``experiment/<name>.yaml`` known."""
+    own = tmp_path / "my_conf" / "experiment"
+    own.mkdir(parents=True)
+    text = (PROJECT_ROOT / "conf" / "experiment" / "demo_scene.yaml").read_text()
+    (own / "my_scene.yaml").write_text(text.replace("name: demo_scene", "name: my_scene", 1))
+    result = cli("--config-dir", str(own.parent), "experiment=my_scene", "scale=quick", "experiment.runs.quick=1")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "experiments" / "my_scene" / "runs").is_dir()
+    unknown = cli("experiment=my_scene", timeout=60)  # without the folder it is not an experiment
+    assert unknown.returncode == 2 and "unknown experiment 'my_scene'" in unknown.stderr
+
+
 def test_the_report_command_prints_its_usage():
     result = subprocess.run([sys.executable, "-m", "replication.report", "--help"], cwd=PROJECT_ROOT,
                             capture_output=True, text=True, timeout=60, check=False)
