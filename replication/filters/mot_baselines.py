@@ -20,10 +20,15 @@ from replication.metrics.mot import BOX, match_boxes
 COLUMNS = ["frame", "id", *BOX]
 
 
+def detection_boxes(detections: pd.DataFrame, min_score: float) -> dict[int, np.ndarray]:
+    """Each frame's (N, 4) detection boxes (x, y, w, h) of score at least ``min_score``."""
+    kept = detections[detections["score"] >= min_score]
+    return {int(frame): rows[BOX].to_numpy(float) for frame, rows in kept.groupby("frame")}
+
+
 def _frames(detections: pd.DataFrame, min_score: float):
     """(frame, (N, 4) boxes) for every frame from 1 to the last detection's, boxes of score >= ``min_score``."""
-    kept = detections[detections["score"] >= min_score]
-    boxes = {frame: rows[BOX].to_numpy(float) for frame, rows in kept.groupby("frame")}
+    boxes = detection_boxes(detections, min_score)
     last = int(detections["frame"].max()) if len(detections) else 0
     for frame in range(1, last + 1):
         yield frame, boxes.get(frame, np.zeros((0, 4)))

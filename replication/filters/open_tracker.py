@@ -30,9 +30,10 @@ import numpy as np
 import pandas as pd
 
 from replication.filters.bis import JointFilter
-from replication.filters.mot_baselines import detections_only, sort
+from replication.filters.mot_baselines import detection_boxes, detections_only, sort
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.metrics.mot import BOX
+from replication.metrics.tracking import centres
 from replication.models.box import BoxModel
 
 OUTPUTS = ("supported", "alive")
@@ -41,13 +42,7 @@ Frame = tuple[int, np.ndarray, np.ndarray]  # MOT frame number, ids (K,), boxes 
 
 def _centred(boxes: np.ndarray) -> np.ndarray:
     """(cx, cy, w, h) of (x, y, w, h) boxes."""
-    return np.column_stack([boxes[:, :2] + boxes[:, 2:4] / 2, boxes[:, 2:4]])
-
-
-def frame_detections(sequence, min_score: float) -> dict[int, np.ndarray]:
-    """Each frame's detection boxes (x, y, w, h) of score at least ``min_score``."""
-    kept = sequence.detections[sequence.detections["score"] >= min_score]
-    return {int(frame): rows[BOX].to_numpy(float) for frame, rows in kept.groupby("frame")}
+    return np.column_stack([centres(boxes), boxes[:, 2:4]])
 
 
 @dataclass
@@ -73,7 +68,7 @@ class ParticleTracker:
             raise ValueError(f"unknown output {self.output!r}; choose one of {OUTPUTS}")
 
     def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
-        detections = frame_detections(sequence, self.min_score)
+        detections = detection_boxes(sequence.detections, self.min_score)
         state = self.method.start([], rng)
         ids, boxes, unsupported = np.zeros(0, int), np.zeros((0, 4)), np.zeros(0, int)
         for frame in frames:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from replication.metrics.mot import iou_matrix, match_boxes
+from replication.metrics.tracking import centres
 
 
 def associate(tracks: np.ndarray, detections: np.ndarray, min_iou: float) -> np.ndarray:
@@ -75,6 +76,6 @@ class Deleter:
 
     def dead(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
         """Which tracks die: ``unsupported`` frames in a row reach ``frames``, or the box's centre is outside the image."""
-        centres = boxes[:, :2] + boxes[:, 2:4] / 2
-        outside = (centres < 0).any(axis=1) | (centres[:, 0] >= size[0]) | (centres[:, 1] >= size[1])
+        centre = centres(boxes)
+        outside = (centre < 0).any(axis=1) | (centre[:, 0] >= size[0]) | (centre[:, 1] >= size[1])
         return (unsupported >= self.frames) | outside

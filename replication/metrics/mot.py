@@ -25,7 +25,7 @@ import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
 from replication.metrics import multi
-from replication.metrics.tracking import iou
+from replication.metrics.tracking import centre_error, iou
 
 BOX = ["x", "y", "w", "h"]
 
@@ -118,8 +118,4 @@ def matched_centre_error(truth: pd.DataFrame, hypotheses: pd.DataFrame, matches:
     keys = ["frame", "id"]
     true = matches.merge(truth, left_on=["frame", "truth_id"], right_on=keys, how="left")
     found = matches.merge(hypotheses, left_on=["frame", "hypothesis_id"], right_on=keys, how="left")
-    return float(np.linalg.norm(_centres(true) - _centres(found), axis=1).mean())
-
-
-def _centres(table: pd.DataFrame) -> np.ndarray:
-    return table[["x", "y"]].to_numpy() + table[["w", "h"]].to_numpy() / 2
+    return float(centre_error(found[BOX].to_numpy(), true[BOX].to_numpy()).mean())

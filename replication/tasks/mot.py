@@ -26,7 +26,7 @@ from replication.filters.bis import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator
 from replication.metrics.hota import hota
-from replication.metrics.mot import BOX, clear_mot_matches, matched_centre_error, mot_metrics
+from replication.metrics.mot import BOX, clear_mot_matches, drop_ignored, matched_centre_error, mot_metrics
 from replication.models.boosted import BoostedBoxModel
 from replication.run import Run
 from replication.scenes.mot import MOT_ROOT, load_mot
@@ -105,10 +105,12 @@ def run(run: Run) -> dict:
     tracks = pd.DataFrame(rows, columns=["frame", "id", *BOX]).round(1).astype({"frame": int, "id": int})  # as stored
     truth, ignored = (table[table["frame"].isin(frames)] for table in (sequence.truth, sequence.ignored))
     min_iou = run.model.get("min_iou", 0.5)
+    kept = drop_ignored(tracks, truth, ignored, min_iou)  # once, for every metric below
     scores = {
-        **mot_metrics(truth, tracks, ignored, min_iou),
-        **hota(truth, tracks, ignored, min_iou),
-        "mean_error_per_target": matched_centre_error(truth, tracks, clear_mot_matches(truth, tracks, ignored, min_iou)),
+        **mot_metrics(truth, kept, min_iou=min_iou),
+        "ignored_hypotheses": len(tracks) - len(kept),
+        **hota(truth, kept, min_iou=min_iou),
+        "mean_error_per_target": matched_centre_error(truth, kept, clear_mot_matches(truth, kept, min_iou=min_iou)),
     }
     return {
         "sequence": sequence.name,
