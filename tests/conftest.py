@@ -56,3 +56,21 @@ def cli(tmp_path):
 
 
 SMALL = ("scale=quick", "experiment.runs.quick=3")
+
+
+@pytest.fixture
+def keep_figures(monkeypatch):
+    """``keep_figures(*modules)``: the figures those report modules draw, kept as matplotlib Figures (their
+    ``save`` replaced) instead of written as PNG files; returns the list they are appended to."""
+    kept = []
+
+    def keep(fig, path, dpi=110):
+        kept.append(fig)
+        return path
+
+    def patch(*modules):
+        for module in modules:
+            monkeypatch.setattr(module, "save", keep)
+        return kept
+
+    return patch

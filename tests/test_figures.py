@@ -24,17 +24,9 @@ PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" +
 
 
 @pytest.fixture
-def drawn(monkeypatch):
+def drawn(keep_figures):
     """The figures drawn, as matplotlib Figures (instead of PNG files)."""
-    kept = []
-
-    def keep(fig, path, dpi=110):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(figures, "save", keep)
-    monkeypatch.setattr(tracking_figures, "save", keep)
-    return kept
+    return keep_figures(figures, tracking_figures)
 
 
 def _scalar_records(values: dict[tuple[str, str], list[float]]) -> pd.DataFrame:
@@ -192,10 +184,6 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 
 
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
-    import pandas as pd
-
-    import replication.report.figures as figures
-
     records = pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]})
     with pytest.raises(ValueError, match="no runs at conditions"):
         figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")

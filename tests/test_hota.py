@@ -11,26 +11,12 @@ import numpy as np
 import pandas as pd
 import pytest
 import trackeval
+from mot_cases import COLUMNS, needs_mot, table, two_walkers
 
 from replication.filters.mot_baselines import sort
 from replication.metrics.hota import SCORES, hota, hota_data
 from replication.metrics.mot import mot_metrics
-from replication.paths import resolve
 from replication.scenes import load_mot
-from replication.scenes.mot import MOT_ROOT
-
-HAVE_MOT = (resolve(MOT_ROOT) / "PETS09-S2L1" / "gt" / "gt.txt").exists()
-needs_mot = pytest.mark.skipif(not HAVE_MOT, reason="../shared/data/mot is not beside the project")
-COLUMNS = ["frame", "id", "x", "y", "w", "h"]
-
-
-def table(rows):
-    return pd.DataFrame(rows, columns=COLUMNS).astype({"frame": int, "id": int})
-
-
-def two_walkers(frames=10):
-    """Two people 200 px apart, each 20 x 40 px, walking right at 5 px per frame; ids 1 and 2."""
-    return table([(k, i, 10 + 5 * k + 200 * (i - 1), 50, 20, 40) for k in range(1, frames + 1) for i in (1, 2)])
 
 
 def one_walker(frames=10):

@@ -5,14 +5,12 @@ import csv
 import cv2
 import numpy as np
 import pytest
+from mot_cases import needs_mot
 
 from replication.paths import resolve
 from replication.scenes import load_mot
 from replication.scenes.factory import SequenceMissing
 from replication.scenes.mot import MOT_ROOT
-
-HAVE_MOT = (resolve(MOT_ROOT) / "PETS09-S2L1" / "gt" / "gt.txt").exists()
-needs_mot = pytest.mark.skipif(not HAVE_MOT, reason="../shared/data/mot is not beside the project")
 
 
 def write_sequence(root, gt="1,1,1,1,10,20,1,-1,-1,-1\n", det="1,-1,1,1,10,20,0.5,-1,-1,-1\n", n_frames=2):

@@ -7,20 +7,16 @@ import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.patches import Rectangle
+from mot_cases import COLUMNS, HAVE_MOT, motmetrics_accumulator, needs_mot, two_walkers
 from PIL import Image, ImageSequence
 
 from replication.filters.mot_baselines import detections_only, sort
 from replication.metrics.mot import clear_mot_matches, drop_ignored, mot_metrics
-from replication.paths import resolve
 from replication.report import mot_figures
 from replication.report.figures import draw
 from replication.report.render import render
 from replication.scenes import load_mot
-from replication.scenes.mot import MOT_ROOT
 
-HAVE_MOT = (resolve(MOT_ROOT) / "PETS09-S2L1" / "gt" / "gt.txt").exists()
-needs_mot = pytest.mark.skipif(not HAVE_MOT, reason="../shared/data/mot is not beside the project")
-COLUMNS = ["frame", "id", "x", "y", "w", "h"]
 EXPERIMENT = {"methods": {"SORT": {"label": "SORT"}, "detections_only": {}},
               "scenes": {"pets": {"kind": "mot", "name": "PETS09-S2L1"}}}
 FIRST, LAST = 101, 250  # the stand-in runs' frames
@@ -47,16 +43,9 @@ def pets():
 
 
 @pytest.fixture
-def drawn(monkeypatch):
+def drawn(keep_figures):
     """The figures drawn, as matplotlib Figures (instead of PNG files)."""
-    kept = []
-
-    def keep(fig, path, dpi=110):
-        kept.append(fig)
-        return path
-
-    monkeypatch.setattr(mot_figures, "save", keep)
-    return kept
+    return keep_figures(mot_figures)
 
 
 def test_a_track_id_has_one_colour_everywhere_and_neighbours_differ():
@@ -69,8 +58,7 @@ def test_a_track_id_has_one_colour_everywhere_and_neighbours_differ():
 
 
 def test_clear_mot_matches_marks_each_switch():
-    walkers = [(k, i, 10 + 5 * k + 200 * (i - 1), 50, 20, 40) for k in range(1, 11) for i in (1, 2)]
-    truth = pd.DataFrame(walkers, columns=COLUMNS)
+    truth = two_walkers()
     hyp = truth.assign(id=np.where((truth["frame"] > 5) == (truth["id"] == 1), 12, 11))
     matches = clear_mot_matches(truth, hyp.drop(index=[0]))  # truth 1 unmatched in frame 1
     assert len(matches) == 19 and matches.columns.tolist() == ["frame", "truth_id", "hypothesis_id", "switch"]
@@ -80,14 +68,7 @@ def test_clear_mot_matches_marks_each_switch():
 
 def motmetrics_matches(truth, hyp):
     """py-motmetrics' MATCH and SWITCH events, as (frame, truth id, hypothesis id, switch)."""
-    mm = pytest.importorskip("motmetrics")
-    acc = mm.MOTAccumulator(auto_id=False)
-    for frame in sorted(set(truth["frame"]) | set(hyp["frame"])):
-        t, h = truth[truth["frame"] == frame], hyp[hyp["frame"] == frame]
-        boxes_t, boxes_h = t[COLUMNS[2:]].to_numpy(float), h[COLUMNS[2:]].to_numpy(float)
-        distance = 1 - mm.distances.boxiou(boxes_t[:, None], boxes_h[None])
-        distance = np.where(distance <= 0.5, distance, np.nan)
-        acc.update(t["id"].tolist(), h["id"].tolist(), distance, frameid=frame)
+    acc = motmetrics_accumulator(truth, hyp)
     events = acc.mot_events.reset_index()
     events = events[events["Type"].isin(["MATCH", "SWITCH"])]
     return sorted(zip(events["FrameId"].astype(int), events["OId"].astype(int), events["HId"].astype(int),

@@ -229,8 +229,6 @@ def test_a_summary_table_is_written_as_numbers_and_read_back_to_the_same_page():
     the PDF (drawn from the CSV) show 'mean [low, high]'."""
     import io
 
-    import pandas as pd
-
     from replication.report.tables import Table, TableKind
 
     records = pd.DataFrame({"method": ["A"] * 6 + ["B"] * 6, "condition": [""] * 12,
