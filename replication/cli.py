@@ -1,11 +1,17 @@
-"""Command line: check the request, run what is missing, write the experiment's report.
+"""``pf-replicate [run|report|scenes] key=value ...`` (or ``python -m replication``): the one entry point.
 
-Errors a user can fix (unknown experiment or key, a value of the wrong type,
-a bad backend or data path) are one line on stderr and exit status 2, before
-any work starts; never a Hydra traceback.  Ctrl-C (SIGINT) stops the workers,
-keeps every run already stored and exits with status 130 and one line.
+``run`` (the default) checks the request, runs what is missing and writes the experiment's report;
+``report`` redraws reports from stored runs (:mod:`replication.report.__main__`); ``scenes`` writes
+an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`).
+
+Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
+broken experiment file, an output folder outside the project or not writable) are one line on
+stderr and exit status 2 before anything heavy is imported or written; never a Hydra traceback.
+Ctrl-C (SIGINT) and SIGTERM stop the workers, keep every run already stored and exit with status
+130 and one line.
 """
 
+import importlib
 import os
 import re
 import signal
@@ -18,13 +24,18 @@ from omegaconf import DictConfig
 
 from replication import __version__
 from replication.errors import ConfigError, fail
-from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.run import Run
-from replication.runner.execute import BackendError, execute
-from replication.runner.store import Store
-from replication.runner.validate import parallel_settings, prepare
+from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
+from replication.runner.preflight import check_yaml, preflight
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
+MULTIRUN_FLAGS = ("--multirun", "-m")
+FLAGS_WITH_VALUES = ("--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn")  # Hydra's: the next word
+# each subcommand's function of argv, imported only when chosen
+SUBCOMMANDS = {
+    "run": "replication.cli:run",
+    "report": "replication.report.__main__:main",
+    "scenes": "replication.scenes.__main__:main",
+}
 
 
 def config_dirs(argv: list[str]) -> list[Path]:
@@ -38,45 +49,70 @@ def config_dirs(argv: list[str]) -> list[Path]:
     return found
 
 
-def check_experiment_argument(argv: list[str]) -> None:
-    """Catch a missing or unknown ``experiment=`` before Hydra turns it into a traceback (Hydra's own
-    flags, which describe the app rather than run it, need none).  Experiments in a ``--config-dir``'s
-    ``experiment/`` folder are known too."""
-    known = experiment_names(*config_dirs(argv))
+def experiment_file(name: str, argv: list[str]) -> Path:
+    """The YAML file Hydra will read for ``experiment=name`` (a ``--config-dir``'s first)."""
+    for folder in (*config_dirs(argv), CONF_DIR):
+        path = Path(folder) / "experiment" / f"{name}.yaml"
+        if path.exists():
+            return path
+    raise ConfigError(f"unknown experiment {name!r}; known: {', '.join(experiment_names(*config_dirs(argv)))}")
+
+
+def chosen_experiments(argv: list[str]) -> list[str]:
+    """The experiments the command line names (several in a multirun), each checked to exist and to
+    parse; none for Hydra's own flags, which describe the app rather than run it."""
     chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
     if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
-        return
+        return []
     if not chosen:
-        fail(f"name an experiment: python -m replication experiment=<name>; known: {', '.join(known)}")
-    for name in chosen[-1].split(","):
-        if name not in known:
-            fail(f"unknown experiment {name!r}; known: {', '.join(known)}")
+        known = ", ".join(experiment_names(*config_dirs(argv)))
+        raise ConfigError(f"name an experiment: pf-replicate experiment=<name>; known: {known}")
+    names = chosen[-1].split(",")
+    for name in names:
+        check_yaml(experiment_file(name, argv))
+    return names
 
 
-def check_overrides(argv: list[str]) -> None:
-    """Compose the config as Hydra will, so that a bad override (an unknown key written
-    without ``+``, a malformed value) is one line rather than Hydra's multi-line report."""
+def check_request(argv: list[str]) -> None:
+    """Compose the config as Hydra will and check it (:mod:`replication.runner.preflight`), so that
+    a bad override (an unknown key written without ``+``, a malformed or out-of-range value) is one
+    line rather than Hydra's multi-line report or a failure after work has started."""
     from hydra import compose, initialize_config_dir
     from hydra.errors import HydraException
 
-    if any(arg.startswith("-") for arg in argv):  # --multirun, --cfg, --help ...: Hydra's own business
+    names = chosen_experiments(argv)
+    if not names or any(arg in HYDRA_FLAGS for arg in argv):
         return
-    overrides = [arg for arg in argv if not arg.lstrip("+~").startswith(("hydra.", "hydra/"))]
-    try:
-        with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-            compose("config", overrides=overrides)
-    except HydraException as error:
-        lines = [line.strip() for line in str(error).splitlines() if line.strip()]
-        unknown = re.fullmatch(r"Could not override '(.+)'\.", lines[0]) if lines else None
-        if unknown:
-            key = unknown[1]
-            fail(f"unknown key {key!r} (check the spelling; a key the config lacks is added as +{key}=...)")
-        fail(" ".join(lines) or error.__class__.__name__)
+    multirun = any(arg in MULTIRUN_FLAGS for arg in argv)
+    flag_values = {i + 1 for i, arg in enumerate(argv) if arg in FLAGS_WITH_VALUES}
+    overrides = [
+        arg for i, arg in enumerate(argv)
+        if i not in flag_values and not arg.startswith(("-", "experiment="))
+        and not arg.lstrip("+~").startswith(("hydra.", "hydra/"))
+        and not (multirun and "," in arg)  # a multirun's sweep: each of its values is a job of its own
+    ]
+    dirs = [str(Path(d).resolve()) for d in config_dirs(argv)]
+    searchpath = [f"hydra.searchpath=[{','.join(f'file://{d}' for d in dirs)}]"] if dirs else []
+    for name in names:
+        try:
+            with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+                cfg = compose("config", overrides=[f"experiment={name}", *overrides, *searchpath])
+        except HydraException as error:
+            lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+            unknown = re.fullmatch(r"Could not override '(.+)'\.", lines[0]) if lines else None
+            if unknown:
+                key = unknown[1]
+                raise ConfigError(
+                    f"unknown key {key!r} (check the spelling; a key the config lacks is added as +{key}=...)"
+                ) from None
+            raise ConfigError(" ".join(lines) or error.__class__.__name__) from None
+        preflight(cfg)
 
 
-def interrupted(store: Store | None = None, runs: list[Run] | None = None) -> None:
-    """The one line of a Ctrl-C, and exit status 130 (128 + SIGINT) as shells expect."""
+def interrupted(store=None, runs=None) -> None:
+    """The one line of a Ctrl-C or SIGTERM, and exit status 130 (128 + SIGINT) as shells expect."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while we count must not print a traceback
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     if store is None or runs is None:
         print("interrupted: rerun the same command to resume", file=sys.stderr)
     else:
@@ -85,8 +121,18 @@ def interrupted(store: Store | None = None, runs: list[Run] | None = None) -> No
     raise SystemExit(130)
 
 
+def terminate_as_interrupt(signum, frame) -> None:
+    """SIGTERM (``kill``, a batch system's time limit) goes the way of Ctrl-C: workers stopped, runs kept."""
+    raise KeyboardInterrupt
+
+
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
 def run_experiment(cfg: DictConfig) -> None:
+    # the numerical stack is imported here, after every check that does not need it has passed
+    from replication.runner.execute import BackendError, execute
+    from replication.runner.store import Store
+    from replication.runner.validate import prepare
+
     if "multiverse" in cfg.experiment:
         return run_multiverse(cfg)
     try:
@@ -115,7 +161,10 @@ def run_experiment(cfg: DictConfig) -> None:
 def run_multiverse(cfg: DictConfig) -> None:
     """Run every universe of a paper's multiverse (:mod:`replication.runner.multiverse`) into its base
     experiments' stores, then write its report and the index."""
+    from replication.runner.execute import BackendError, execute
     from replication.runner.multiverse import load
+    from replication.runner.store import Store
+    from replication.runner.validate import parallel_settings
 
     try:
         multiverse = load(cfg)
@@ -145,8 +194,9 @@ def run_multiverse(cfg: DictConfig) -> None:
 
 def run_companions(cfg: DictConfig) -> None:
     """Run the experiments a paper's main one names in ``also:`` (e.g. hspf's UNGM half), with the same
-    settings except those addressed to this experiment (``experiment.*``)."""
-    shared = [a for a in sys.argv[1:] if not a.startswith(("experiment=", "experiment.", "+experiment.", "-"))]
+    settings except those addressed to this experiment (``experiment.*``, its ``sequences=``)."""
+    own = ("experiment=", "experiment.", "+experiment.", "sequences=", "-")
+    shared = [a for a in sys.argv[1:] if not a.startswith(own)]
     for name in cfg.experiment.get("also", []) or []:
         print(f"{cfg.experiment.name}: also {name}")
         status = subprocess.run([sys.executable, "-m", "replication", f"experiment={name}", *shared]).returncode
@@ -159,17 +209,28 @@ def run_companions(cfg: DictConfig) -> None:
 QUIET_CHILDREN = "ignore::UserWarning:joblib.externals.loky.backend.resource_tracker"
 
 
-def main() -> None:
+def run(argv: list[str]) -> None:
+    """``pf-replicate [run] experiment=<name> ...``: check everything, then hand over to Hydra."""
+    if "--version" in argv:
+        print(f"pf-replicate {__version__}")
+        return
+    try:
+        check_request(argv)
+    except ConfigError as error:
+        fail(str(error))
+    sys.argv = [sys.argv[0], *argv]  # Hydra reads the command line itself
+    run_experiment()
+
+
+def main(argv: list[str] | None = None) -> None:
+    argv = sys.argv[1:] if argv is None else argv
     if QUIET_CHILDREN not in os.environ.get("PYTHONWARNINGS", ""):
         os.environ["PYTHONWARNINGS"] = ",".join(filter(None, [os.environ.get("PYTHONWARNINGS"), QUIET_CHILDREN]))
+    os.environ[HOME_VARIABLE] = str(project_dir())  # workers and companions resolve paths as we do
+    signal.signal(signal.SIGTERM, terminate_as_interrupt)
+    command, argv = (argv[0], argv[1:]) if argv and argv[0] in SUBCOMMANDS else ("run", argv)
     try:
-        argv = sys.argv[1:]
-        if "--version" in argv:
-            print(f"replication {__version__}")
-            return
-        check_experiment_argument(argv)
-        check_overrides(argv)
-        run_experiment()
+        module, function = SUBCOMMANDS[command].split(":")
+        getattr(importlib.import_module(module), function)(argv)
     except KeyboardInterrupt:
         interrupted()
-

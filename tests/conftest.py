@@ -1,10 +1,13 @@
 import signal
 import sys
+from pathlib import Path
 
 import pytest
 from hydra import compose, initialize_config_dir
 
-from replication.paths import CONF_DIR, PROJECT_ROOT
+from replication.paths import CONF_DIR
+
+PROJECT_ROOT = Path(__file__).resolve().parents[1]  # the checkout: the commands run from it
 
 
 def pytest_configure(config):
@@ -48,6 +51,7 @@ def cli(tmp_path):
             *args,
             f"store={tmp_path / 'experiments'}",
             f"reports={tmp_path / 'reports'}",
+            "outside_project=true",
             "progress=false",
         ]
         return subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=timeout, env=env)

@@ -12,9 +12,8 @@ import time
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import SMALL
+from conftest import PROJECT_ROOT, SMALL
 
-from replication.paths import PROJECT_ROOT
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.provenance import code_digest
@@ -33,13 +32,13 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
         (("experiment=no_such_paper",), "unknown experiment 'no_such_paper'"),
         ((), "name an experiment"),
         (("experiment=gps_qmcpf", "experiment.methods.PF.filter=magic"), "unknown filter 'magic'"),
-        (("experiment=gps_qmcpf", "+experiment.methods.XPF.n_particles=10"), "method 'XPF': no 'filter:' key"),
+        (("experiment=gps_qmcpf", "+experiment.methods.XPF.n_particles=10"), "experiment.methods.XPF names no filter"),
         (("experiment=hspf_ungm", "experiment.methods.PF.n_particles=0"), "n_particles must be a positive"),
-        (("experiment=gps_qmcpf", "experiment.methods.PF.sweep.n_particles=[100,-5]"), "at N=-5"),
+        (("experiment=gps_qmcpf", "experiment.methods.PF.sweep.n_particles=[100,-5]"), "positive integer, got -5"),
         (("experiment=gps_qmcpf", "experiment.methods.PF.sweep.n_particles=5"), "must be a non-empty list"),
         (("experiment=gps_qmcpf", "scale=huge"), "scale must be one of"),
         (("experiment=gps_qmcpf", "experiment.model.name=lorenz"), "unknown model 'lorenz'"),
-        (("experiment=gps_qmcpf", "experiment.model.Q=-1"), "noise variances must be positive"),
+        (("experiment=gps_qmcpf", "experiment.model.Q=-1"), "experiment.model.Q must be positive"),
         (("experiment=gps_qmcpf", "experiment.methods.PF.resampling=bogus"), "unknown resampling"),
     ],
 )
@@ -59,7 +58,7 @@ def test_bad_requests_fail_fast_with_one_line(cli, tmp_path, args, message):
         (("experiment=bis_pf", "--help"), "Main settings"),
         (("--cfg", "job"), "base_seed: 20261121"),
         (("--info", "searchpath"), "Config search path"),
-        (("--version",), "replication 0.1.0"),
+        (("--version",), "pf-replicate 0.1.0"),
     ],
 )
 def test_hydra_flags_describe_the_app_without_an_experiment(args, expected):
@@ -156,7 +155,7 @@ def test_changed_config_lands_in_new_files(make_cfg, tmp_path):
 
 def test_changed_code_lands_in_new_runs(tmp_path):
     """A copy of the project whose bootstrap filter differs by one comment recomputes every run; a change
-    to the report layer (which only reads records) reuses them.  Run through the CLI, as a user would."""
+    to the report layer, the command line or the reader of records reuses them.  Run through the CLI."""
     copy = tmp_path / "project"
     shutil.copytree(PROJECT_ROOT, copy, ignore=shutil.ignore_patterns(".venv", ".git", "experiments", "reports",
                                                                       "__pycache__", "*.egg-info"))
@@ -171,8 +170,9 @@ def test_changed_code_lands_in_new_runs(tmp_path):
 
     first = computed()
     assert first > 0 and computed() == 0
-    with open(copy / "replication" / "report" / "render.py", "a") as report:
-        report.write("# a report change\n")
+    for reader in ("report/render.py", "cli.py", "runner/results.py"):  # they never compute a run
+        with open(copy / "replication" / reader, "a") as code:
+            code.write("# a change that computes nothing\n")
     assert computed() == 0
     runs_dir = copy / "experiments" / "hspf_ungm" / "runs"
     earlier = set(runs_dir.glob("*.json"))  # they stay beside the new runs: read a new one
@@ -205,7 +205,8 @@ def test_interrupted_job_resumes_to_the_same_table(tmp_path):
     args = ["experiment=ungm_horizon", "scale=quick", "experiment.runs.quick=6", "n_jobs=2", "progress=false"]
 
     def command(store):
-        return [sys.executable, "-m", "replication", *args, f"store={store}", f"reports={tmp_path / 'reports'}"]
+        return [sys.executable, "-m", "replication", *args, f"store={store}", f"reports={tmp_path / 'reports'}",
+                "outside_project=true"]
 
     reference = subprocess.run(command(tmp_path / "a"), cwd=PROJECT_ROOT, capture_output=True, text=True)
     assert reference.returncode == 0, reference.stderr
@@ -270,6 +271,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
     result = cli("-m", "experiment=ungm_horizon", *settings, "experiment.methods.grid.n_points=201,1601")
     assert result.returncode == 0, result.stderr
     assert "9 runs computed, 0 already stored" in result.stdout and "3 runs computed, 6 already stored" in result.stdout
+    assert "sweep not drawn (ungm_horizon: no table names a metric" in result.stderr  # and the command to finish
     assert list((tmp_path / "experiments" / "multirun").glob("*/multirun.yaml"))  # Hydra's record, under the store
     report = subprocess.run(
         [sys.executable, "-m", "replication.report", "experiment=ungm_horizon", *settings, f"store={tmp_path / 'experiments'}",
@@ -292,3 +294,15 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
                           f"store={tmp_path / 'experiments'}", "sweep=experiment.methods.grid.n_points=201", "metric=nope"],
                          cwd=PROJECT_ROOT, capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "metric 'nope'" in bad.stderr
+
+
+def test_a_multirun_draws_its_sweep_at_its_end(cli, tmp_path):
+    """The Hydra callback draws the sweep of one setting when the multirun ends: no retyping."""
+    result = cli("-m", "experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=5", "experiment.methods.grid.n_points=201",
+                 "experiment.methods.PF.n_particles=50,100")
+    assert result.returncode == 0, result.stderr
+    page = tmp_path / "reports" / "hspf_ungm" / "sweeps" / "experiment.methods.PF.n_particles.html"
+    assert page.exists() and "sweep: " in result.stdout
+    table = pd.read_csv(page.with_suffix(".csv"))
+    swept = table[table["method"] == "PF"]
+    assert set(swept["condition"]) == {"n_particles=50", "n_particles=100"} and (swept["runs"] == 5).all()

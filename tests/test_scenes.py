@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from conftest import PROJECT_ROOT
 
 from replication.scenes import OTBSequence, SyntheticScene
 from replication.scenes.export import write_sequence
@@ -177,8 +178,6 @@ def test_export_writes_a_playable_mp4(tmp_path):
 def test_scene_writer_command(tmp_path):
     import subprocess
     import sys
-
-    from replication.paths import PROJECT_ROOT
 
     command = [sys.executable, "-m", "replication.scenes", "experiment=demo_scene", f"out={tmp_path}", "format=images"]
     result = subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120)

@@ -22,6 +22,7 @@ from replication.report.index import write_index
 from replication.report.multiverse import write_multiverse_report
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
+from replication.runner.preflight import check_yaml
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
@@ -54,6 +55,13 @@ def main(argv: list[str]) -> None:
         fail("metric= only goes with sweep=")
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         for name in names:
+            try:
+                check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
+            except ConfigError as error:
+                if chosen:  # named on the command line: the user wants to know
+                    fail(str(error))
+                print(f"skipped: {error}", file=sys.stderr)  # one broken file never breaks the others
+                continue
             cfg = compose("config", overrides=[f"experiment={name}", *overrides])
             try:
                 if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs

@@ -20,13 +20,13 @@ from replication.report.scale import scale_changes, scale_note
 from replication.report.tables import TableKind
 from replication.report.verdict import RULES, Verdict
 from replication.run import Run
-from replication.runner.config import at_scale
+from replication.runner.config import experiment_at_scale
 from replication.runner.store import Store
 
 
 def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> Path:
     """Write ``<reports>/<experiment>/`` from the stored records of ``runs``; return the page's path."""
-    experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale)
+    experiment = experiment_at_scale(cfg)
     out = resolve(cfg.reports) / experiment["name"]
     out.mkdir(parents=True, exist_ok=True)
     records = store.load(runs)

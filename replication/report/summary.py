@@ -11,6 +11,7 @@ replicated at all.
 """
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -42,10 +43,21 @@ def experiment_configs() -> dict[str, dict]:
     re-draws its parent's tables on other settings, and a published cell is
     compared only with the experiment that declares its table.  Plain YAML
     (the configs use anchors, no interpolation): 20 times faster than OmegaConf here.
+    A file that does not parse is left out with one line on stderr: it never breaks another's report.
     """
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    return {name: yaml.load((CONF_DIR / "experiment" / f"{name}.yaml").read_text(), Loader=loader)
-            for name in experiment_names()}
+    configs = {}
+    for name in experiment_names():
+        path = CONF_DIR / "experiment" / f"{name}.yaml"
+        try:
+            configs[name] = yaml.load(path.read_text(), Loader=loader)
+        except yaml.YAMLError as error:
+            print(f"skipped: {path} does not parse ({str(error).splitlines()[0]})", file=sys.stderr)
+            continue
+        if not isinstance(configs[name], dict):
+            print(f"skipped: {path} holds no experiment", file=sys.stderr)
+            del configs[name]
+    return configs
 
 
 def summary_table(

@@ -23,6 +23,7 @@ from replication.errors import ConfigError
 from replication.filters import FILTERS, build_filter
 from replication.run import Run
 from replication.runner.provenance import code_digest
+from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
 
 SCALES = ("paper", "quick")
@@ -65,6 +66,13 @@ def at_scale(value: Any, scale: str) -> Any:
     return value
 
 
+def experiment_at_scale(cfg: DictConfig) -> dict:
+    """``cfg.experiment`` as plain data at ``cfg.scale``, its real sequences located (``data.*``,
+    ``sequences=``: :mod:`replication.runner.sequences`): what the runs and the report both read."""
+    experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale)
+    return locate_sequences(experiment, cfg.get("data"), cfg.get("sequences"))
+
+
 def n_runs(cfg: DictConfig) -> int:
     scale = cfg.scale
     if scale not in SCALES:
@@ -86,10 +94,11 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     if exp.get("task") not in TASKS:
         raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
     task = TASKS[exp.task]
-    model = at_scale(OmegaConf.to_container(exp.model, resolve=True), cfg.scale)
+    experiment = experiment_at_scale(cfg)
+    model = dict(experiment["model"])
     model_sweeps = _sweeps(model, True, "model")
-    scenes = at_scale(OmegaConf.to_container(exp.scenes, resolve=True), cfg.scale) if "scenes" in exp else {}
-    methods = at_scale(OmegaConf.to_container(exp.methods, resolve=True), cfg.scale)
+    scenes = experiment.get("scenes", {})
+    methods = experiment["methods"]
     if not methods:
         raise ConfigError("experiment.methods is empty")
     runs, skipped = [], [] if skipped is None else skipped

@@ -35,7 +35,7 @@ from scipy.stats import qmc
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, experiment_names
 from replication.run import Run
-from replication.runner.config import at_scale
+from replication.runner.config import at_scale, experiment_at_scale
 from replication.runner.validate import prepare
 
 NAME = re.compile(r"[a-z][a-z0-9_]*")
@@ -228,7 +228,7 @@ def load(cfg: DictConfig) -> Multiverse:
             except ConfigError as error:
                 raise ConfigError(f"{exp.name}, universe {universe.name}, {name}: {error}") from None
             skipped.update(dict.fromkeys(missing))
-            configs[universe.name, name] = at_scale(experiment, cfg.scale)
+            configs[universe.name, name] = experiment_at_scale(derived)
     return Multiverse(exp.name, exp.paper, experiments, choices, universes, runs, configs, tuple(skipped))
 
 

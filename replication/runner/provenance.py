@@ -2,8 +2,8 @@
 
 :func:`code_digest` is part of every run key, so a change to any module that
 can change a run's numbers gives new runs rather than stale ones.  It hashes
-the source of every module of the package except the report layer
-(``replication/report/``), which only reads stored records.
+the source of every module of the package except those that never compute a run
+(:data:`READ_ONLY`: the report layer, the command line, the reader of stored records).
 :func:`provenance` is written into every record, and the report shows it.
 """
 
@@ -16,7 +16,9 @@ from functools import lru_cache
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent
-READ_ONLY = ("report",)  # sub-packages that never compute a run
+# what never computes a run (prefixes of paths inside the package): the report layer, the command
+# line and its checks, the reader of stored runs
+READ_ONLY = ("report/", "cli.py", "__main__.py", "scenes/__main__.py", "runner/preflight.py", "runner/results.py")
 LIBRARIES = {"numpy": "numpy", "scipy": "scipy", "opencv": "opencv-python-headless", "numba": "numba"}  # column: distribution
 
 
@@ -26,7 +28,7 @@ def code_digest(package: Path = PACKAGE) -> str:
     digest = hashlib.sha256()
     for path in sorted(package.rglob("*.py")):
         relative = path.relative_to(package)
-        if relative.parts[0] in READ_ONLY:
+        if relative.as_posix().startswith(READ_ONLY):
             continue
         digest.update(relative.as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:12]

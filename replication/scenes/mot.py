@@ -13,6 +13,7 @@ converted from MOT's 1-based pixel coordinates to the project's 0-based (x, y, w
 
 import configparser
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +24,7 @@ import pandas as pd
 from replication.paths import resolve
 from replication.scenes.factory import SequenceMissing
 
-MOT_ROOT = "../shared/data/mot"
+MOT_ROOT = os.environ.get("REPLICATION_MOT") or "../shared/data/mot"  # data.mot in conf/config.yaml
 BOX = ["x", "y", "w", "h"]
 
 

@@ -5,16 +5,18 @@ subtracting 1 from x and y.  Separators vary (comma, TAB, spaces) and some files
 use CRLF, so rows are split on ``[,\\s]+``.
 """
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import cv2
 import numpy as np
+from PIL import Image, UnidentifiedImageError
 
 from replication.paths import resolve
 
-OTB_ROOT = "../shared/data/otb"
+OTB_ROOT = os.environ.get("REPLICATION_OTB") or "../shared/data/otb"  # data.otb in conf/config.yaml
 # Sequences whose usual ground-truth file is not groundtruth_rect.txt (see SOURCES.md).
 GROUNDTRUTH_FILES = {"Jogging-1": ("Jogging", "groundtruth_rect.1.txt"), "Jogging-2": ("Jogging", "groundtruth_rect.2.txt")}
 
@@ -54,16 +56,49 @@ class OTBSequence:
         stop = len(frames) if self.last is None else self.last
         self._frames = frames[self.first : stop]
         self.truth = truth[self.first : stop, None, :]
+        check_truth(self.truth[:, 0], directory / gt_name, self.first)
         self.visibility = np.ones(self.truth.shape[:2])
         self.n_frames = len(self._frames)
-        height, width = self.frame(0).shape[:2]
-        self.size = (width, height)
+        self.size = frame_size(self._frames)
 
     def frame(self, k: int) -> np.ndarray:
         image = cv2.imread(str(self._frames[k]), cv2.IMREAD_COLOR)
         if image is None:
             raise OSError(f"cannot read {self._frames[k]}")
         return image
+
+
+def check_truth(boxes: np.ndarray, path: Path, first: int) -> None:
+    """Every ground-truth row finite, and the first box (the tracker's initial state) non-empty."""
+    bad = np.flatnonzero(~np.isfinite(boxes).all(axis=1))
+    if bad.size:
+        raise ValueError(f"{path}:{first + bad[0] + 1}: a ground-truth box that is not four finite numbers")
+    if boxes.size and (boxes[0, 2] <= 0 or boxes[0, 3] <= 0):
+        raise ValueError(f"{path}:{first + 1}: the first box has no area (w, h = {boxes[0, 2]:g}, {boxes[0, 3]:g})")
+
+
+def frame_size(frames: list[Path]) -> tuple[int, int]:
+    """The (width, height) every frame shares, read from the files' headers (no decoding)."""
+    if not frames:
+        raise ValueError("no frames")
+    size = None
+    for path in frames:
+        try:
+            with Image.open(path) as image:
+                size, seen = size or image.size, image.size
+        except (OSError, UnidentifiedImageError):
+            raise ValueError(f"{path}: not a readable image") from None
+        if seen != size:
+            raise ValueError(f"{path}: {seen[0]}x{seen[1]} pixels where the frames before it are {size[0]}x{size[1]}")
+    return size
+
+
+def otb_names(root: str = OTB_ROOT) -> list[str]:
+    """Every sequence under ``root``: its folders holding ``img/`` and a ground truth, by name."""
+    folders = {p.parent.name for p in resolve(root).glob("*/img")}
+    special = {name for name, (folder, _) in GROUNDTRUTH_FILES.items() if folder in folders}
+    plain = {f for f in folders if (resolve(root) / f / "groundtruth_rect.txt").exists()}
+    return sorted(plain | special)
 
 
 def find_otb(names: list[str], root: str = OTB_ROOT) -> tuple[list[str], list[str]]:
