@@ -5,8 +5,12 @@ Both initialise on the first frame, which ``start`` reads from ``model.first_fra
 ``model.initial_box``).  A step where a tracker reports failure keeps the previous box.
 
 * MIL (Babenko, Yang and Belongie, CVPR 2009): OpenCV's ``cv2.TrackerMIL`` as is, default parameters
-  (hspf ran "the authors' code").  Its samples come from an OpenCV generator that the run's seed does not
-  control (``cv2.setRNGSeed`` does not make it repeat), so runs differ.
+  (hspf ran "the authors' code").  It draws from two generators: its Haar features from the C library's
+  ``rand()`` (``tracking_feature.cpp``) and its image samples from a copy of OpenCV's ``theRNG()`` taken
+  when the tracker is made (``TrackerSamplerCSC``).  ``cv2.setRNGSeed`` alone seeds only the second, so
+  the features followed from whatever the worker process had run before.  Both are seeded from the
+  run's stream before the tracker is made: a run repeats (any process, any order), and runs with other
+  seeds differ as MIL's own randomness makes them.
 * DFT (Sevilla-Lara and Learned-Miller, CVPR 2012): a distribution field is a per-pixel one-hot over
   ``bins`` grey levels, smoothed by a spatial Gaussian and a Gaussian across bins; the target is the box
   whose field has the least L1 distance to the template field.  As in the authors' code (``run_DFT.m`` in
@@ -20,7 +24,9 @@ Both initialise on the first frame, which ``start`` reads from ``model.first_fra
   under constant velocity v).
 """
 
+import ctypes
 import dataclasses
+import threading
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any
@@ -31,6 +37,8 @@ import numpy as np
 from replication.smc.loop import FilterOutput, Summaries
 
 NEIGHBOURS = np.array([[-1, 0], [0, 1], [1, 0], [0, -1]])  # (row, col) steps of the DFT descent
+C_LIBRARY = ctypes.CDLL(None)  # the process's C library (POSIX), whose rand() OpenCV's Haar features use
+SEEDING = threading.Lock()  # rand() is one per process: seeding and drawing the features go together
 
 
 @dataclass
@@ -61,8 +69,6 @@ def corner_box(box: np.ndarray) -> tuple[int, int, int, int]:
 
 class BoxTracker(ABC):
     """A tracker that keeps one box, driven as a single-target filter: ``start(model, rng)``, ``step(state, frame)``."""
-
-    deterministic = True  # the same frames give the same boxes: one run per condition is enough
 
     @abstractmethod
     def initialise(self, frame: np.ndarray, box: np.ndarray) -> Any:
@@ -96,9 +102,14 @@ class BoxTracker(ABC):
 
 
 class MILTracker(BoxTracker):
-    """OpenCV's MIL tracker (``cv2.TrackerMIL``, default parameters)."""
+    """OpenCV's MIL tracker (``cv2.TrackerMIL``, default parameters), its generators seeded from ``rng``."""
 
-    deterministic = False
+    def start(self, model, rng: np.random.Generator) -> BoxState:
+        seed = int(rng.integers(2**31))
+        with SEEDING:  # under a thread backend, no other run's tracker draws features in between
+            cv2.setRNGSeed(seed)
+            C_LIBRARY.srand(seed)
+            return super().start(model, rng)
 
     def initialise(self, frame, box):
         tracker = cv2.TrackerMIL.create()

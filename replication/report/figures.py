@@ -198,7 +198,9 @@ def _legend(ax) -> int:
 def _figures():
     from replication.report.mot_figures import identity_timeline, track_snapshots, track_video
     from replication.report.qmc_figures import point_sets
-    from replication.report.tracking_figures import mode_strip, otb_curves, per_frame_curve, snapshots, track
+    from replication.report.tracking_figures import (
+        attribute_map, mode_strip, otb_curves, per_frame_curve, snapshots, track,
+    )
 
     return {
         "metric_vs_condition": metric_vs_condition,
@@ -208,6 +210,7 @@ def _figures():
         "mode_strip": mode_strip,
         "point_sets": point_sets,
         "otb_curves": otb_curves,
+        "attribute_map": attribute_map,
         "track_snapshots": track_snapshots,
         "identity_timeline": identity_timeline,
         "track_video": track_video,

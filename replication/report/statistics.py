@@ -4,6 +4,8 @@
   ``scipy.stats.binomtest(k, n).proportion_ci(method="wilson")``;
 * a mean of a bounded or skewed per-run metric: the BCa bootstrap over runs,
   ``scipy.stats.bootstrap(..., method="BCa")``, clipped to the metric's range;
+* a mean over a fixed set of sequences of each one's mean over runs (OTB's per-attribute scores): the
+  BCa bootstrap resampling the runs within each sequence;
 * a median (timings): the distribution-free interval between order statistics;
 * a paired difference (two methods on the same data, common random numbers):
   the BCa bootstrap of the mean of the per-run differences;
@@ -88,19 +90,48 @@ def bootstrap_mean(values, low: float = -math.inf, high: float = math.inf) -> Es
         return Estimate(mean, math.nan, math.nan, 1, "bootstrap")
     if np.all(values == values[0]):
         return Estimate(mean, mean, mean, len(values), "bootstrap (all runs equal)")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # BCa's degenerate-data warning: handled below
-        interval = stats.bootstrap((values,), np.mean, method="BCa", confidence_level=LEVEL, n_resamples=RESAMPLES,
-                                   random_state=np.random.default_rng(SEED)).confidence_interval
-    lo, hi = float(interval.low), float(interval.high)
-    if not (math.isfinite(lo) and math.isfinite(hi)):  # BCa undefined (e.g. one run differs from the rest)
+    lo, hi = _bootstrap((values,), np.mean)
+    return Estimate(mean, max(lo, low), min(hi, high), len(values), "BCa bootstrap")
+
+
+def stratified_mean(groups, low: float = -math.inf, high: float = math.inf, min_runs: int = 2) -> Estimate:
+    """The mean over ``groups`` of each group's mean over its runs (every group weighs the same: OTB's
+    mean over sequences), with the BCa bootstrap interval that resamples the runs within each group, the
+    groups held fixed (they are the sequences at hand, not a sample of sequences), clipped to [low, high].
+
+    No interval when a group has fewer than ``min_runs`` runs; ``runs`` counts every run.
+    """
+    groups = [_finite(values) for values in groups]
+    groups = [values for values in groups if len(values)]
+    if not groups:
+        return Estimate(math.nan, math.nan, math.nan, 0, "stratified bootstrap")
+    mean = float(np.mean([values.mean() for values in groups]))
+    runs = sum(len(values) for values in groups)
+    if min(len(values) for values in groups) < max(min_runs, 2):
+        return Estimate(mean, math.nan, math.nan, runs, "stratified bootstrap")
+    if all(np.all(values == values[0]) for values in groups):
+        return Estimate(mean, mean, mean, runs, "stratified bootstrap (all runs equal)")
+    lo, hi = _bootstrap(groups, _mean_of_means)
+    return Estimate(mean, max(lo, low), min(hi, high), runs, "stratified BCa bootstrap")
+
+
+def _mean_of_means(*groups, axis=-1):
+    return np.mean([values.mean(axis=axis) for values in groups], axis=0)
+
+
+def _bootstrap(samples, statistic) -> tuple[float, float]:
+    """The 95% BCa bootstrap interval of ``statistic`` over ``samples`` (each resampled on its own), or the
+    percentile interval where BCa is undefined (e.g. one run differs from the rest)."""
+    for method in ("BCa", "percentile"):
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            interval = stats.bootstrap((values,), np.mean, method="percentile", confidence_level=LEVEL,
+            warnings.simplefilter("ignore")  # BCa's degenerate-data warning: handled by the fallback
+            interval = stats.bootstrap(tuple(samples), statistic, method=method, confidence_level=LEVEL,
                                        n_resamples=RESAMPLES, random_state=np.random.default_rng(SEED)
                                        ).confidence_interval
         lo, hi = float(interval.low), float(interval.high)
-    return Estimate(mean, max(lo, low), min(hi, high), len(values), "BCa bootstrap")
+        if math.isfinite(lo) and math.isfinite(hi):
+            break
+    return lo, hi
 
 
 def median(values) -> Estimate:

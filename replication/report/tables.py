@@ -18,6 +18,7 @@ import pandas as pd
 
 from replication.qmc import discrepancy_table
 from replication.report.aggregate import summarise
+from replication.report.attributes import attribute_scores, carried_by
 from replication.report.modes import runs_keeping_both_modes
 from replication.report.published import cells
 from replication.report.quantities import quantity
@@ -297,6 +298,26 @@ class Summary(TableKind):
             table[metric] = [Estimate(*values, "") for values in
                              zip(summary["mean"], summary["ci_low"], summary["ci_high"], summary["runs"])]
         return Table(table)
+
+
+class Attributes(TableKind):
+    """OTB's per-attribute view: precision at 20 px and success AUC per attribute and method, each the
+    mean over the sequences that carry the attribute (:mod:`replication.report.attributes`)."""
+
+    kind = "otb_attributes"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        scores = attribute_scores(records, self.experiment)
+        return Table(pd.DataFrame({
+            "attribute": [f"{code} ({meaning})" for code, meaning in zip(scores["attribute"], scores["meaning"])],
+            "sequences": [carried_by(sequences) for sequences in scores["sequences"]],
+            "method": [self.label(method) for method in scores["method"]],
+            "condition": [series or "-" for series in scores["series"]],
+            "runs": scores["runs"],  # the fewest on one sequence
+            "precision20": scores["precision20"],
+            "success_auc": scores["success_auc"],
+        }))
 
 
 class Discrepancy(TableKind):

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import to_rgb
 
+from replication.report.attributes import absent, attribute_scores
 from replication.report.style import (
     axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
 )
@@ -217,4 +218,47 @@ def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     for ax in (left, right):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
+    return save(fig, path)
+
+
+def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """OTB's per-attribute view as heat maps, methods down and attributes across: precision at 20 px,
+    then success AUC, each the mean over the sequences carrying the attribute (under its code: how many,
+    or the one sequence by name); the best method of each attribute is framed.
+    """
+    scores = attribute_scores(records, experiment)
+    rows = list(dict.fromkeys(zip(scores["method"], scores["series"])))
+    codes = list(dict.fromkeys(scores["attribute"]))
+    panels = [("precision20", "precision at 20 px"), ("success_auc", "success AUC")]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(2.5 + 0.75 * max(len(codes), 4), 2 * (1.2 + 0.35 * len(rows))),
+                             squeeze=False)
+    if scores.empty:
+        for ax in axes[:, 0]:
+            ax.axis("off")
+        axes[0, 0].text(0.5, 0.5, "no sequence here has OTB attributes listed", ha="center", va="center")
+        return save(fig, path)
+    carriers = {code: sorted(set().union(*group)) for code, group in scores.groupby("attribute")["sequences"]}
+    columns = [f"{code}\n{carriers[code][0] if len(carriers[code]) == 1 else f'{len(carriers[code])} seq.'}"
+               for code in codes]
+    labels = [f"{method_label(experiment, method)} {series}".strip() for method, series in rows]
+    for ax, (metric, name) in zip(axes[:, 0], panels):
+        values = np.full((len(rows), len(codes)), np.nan)
+        for method, series, code, estimate in zip(scores["method"], scores["series"], scores["attribute"],
+                                                  scores[metric]):
+            values[rows.index((method, series)), codes.index(code)] = estimate.value
+        image = ax.imshow(values, cmap="viridis", vmin=0.0, vmax=1.0, aspect="auto")
+        best = np.nanmax(values, axis=0)
+        for (r, c), value in np.ndenumerate(values):
+            if np.isfinite(value):
+                ax.text(c, r, f"{value:.2f}", ha="center", va="center", fontsize=7,
+                        color="black" if value > 0.6 else "white")
+                if value == best[c]:
+                    ax.add_patch(plt.Rectangle((c - 0.5, r - 0.5), 1, 1, fill=False, edgecolor="red", lw=1.5))
+        ax.set_xticks(range(len(codes)), columns, fontsize=7)
+        ax.set_yticks(range(len(rows)), labels, fontsize=7)
+        ax.set_title(f"{name} per attribute (mean over the sequences carrying it; best framed)", fontsize=9)
+        fig.colorbar(image, ax=ax, fraction=0.03, pad=0.02)
+    missing = absent(scores)
+    if missing:
+        axes[-1, 0].set_xlabel(f"no sequence here carries {', '.join(missing)}", fontsize=7)
     return save(fig, path)

@@ -2,9 +2,11 @@
 
 OTB boxes are 1-based (x, y, w, h); they are turned into our 0-based boxes by
 subtracting 1 from x and y.  Separators vary (comma, TAB, spaces) and some files
-use CRLF, so rows are split on ``[,\\s]+``.
+use CRLF, so rows are split on ``[,\\s]+``.  OTB-100's attributes of the sequences
+(occlusion, scale variation...) are data, ``otb_attributes.yaml``.
 """
 
+import functools
 import os
 import re
 from dataclasses import dataclass, field
@@ -12,6 +14,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import yaml
 from PIL import Image, UnidentifiedImageError
 
 from replication.paths import resolve
@@ -19,6 +22,7 @@ from replication.paths import resolve
 OTB_ROOT = os.environ.get("REPLICATION_OTB") or "../shared/data/otb"  # data.otb in conf/config.yaml
 # Sequences whose usual ground-truth file is not groundtruth_rect.txt (see SOURCES.md).
 GROUNDTRUTH_FILES = {"Jogging-1": ("Jogging", "groundtruth_rect.1.txt"), "Jogging-2": ("Jogging", "groundtruth_rect.2.txt")}
+ATTRIBUTES_FILE = Path(__file__).with_name("otb_attributes.yaml")
 
 
 def read_groundtruth(path: Path) -> np.ndarray:
@@ -112,3 +116,16 @@ def find_otb(names: list[str], root: str = OTB_ROOT) -> tuple[list[str], list[st
         else:
             missing.append(f"OTB sequence {name!r} is not in {directory.parent}: skipped")
     return present, missing
+
+
+@functools.cache
+def otb_attributes() -> tuple[dict[str, str], dict[str, list[str]]]:
+    """OTB's attributes (code -> meaning, in the benchmark's order) and the codes of each sequence listed
+    in ``otb_attributes.yaml``; a sequence with a code that is not an attribute is an error."""
+    table = yaml.safe_load(ATTRIBUTES_FILE.read_text())
+    meanings, sequences = table["attributes"], table["sequences"]
+    for name, codes in sequences.items():
+        unknown = sorted(set(codes) - set(meanings))
+        if unknown:
+            raise ValueError(f"{ATTRIBUTES_FILE.name}: {name} has unknown attributes {unknown}; known: {list(meanings)}")
+    return meanings, sequences
