@@ -16,6 +16,7 @@ from replication.report import mot_figures
 from replication.report.figures import draw
 from replication.report.render import render
 from replication.scenes import load_mot
+from replication.tasks.mot import frame_table
 
 EXPERIMENT = {"methods": {"SORT": {"label": "SORT"}, "detections_only": {}},
               "scenes": {"pets": {"kind": "mot", "name": "PETS09-S2L1"}}}
@@ -81,7 +82,7 @@ def test_the_timeline_matches_are_motmetrics_matches_on_pets():
     run = {"tracks": sort(sequence.detections)[COLUMNS].values.tolist(), "first_frame": 1,
            "last_frame": sequence.n_frames}
     truth, ours = mot_figures.timeline_matches(sequence, run)
-    kept = drop_ignored(mot_figures.tracks_table(run), sequence.truth, sequence.ignored)
+    kept = drop_ignored(frame_table(run), sequence.truth, sequence.ignored)
     theirs = motmetrics_matches(truth, kept)
     assert sorted(ours.itertuples(index=False, name=None)) == theirs
     assert 3000 < len(ours) and ours["switch"].sum() > 0  # SORT on PETS: thousands of matches, some switches

@@ -1,4 +1,6 @@
-"""One experiment's report: its tables as CSV and HTML, its figures, and a page tying them together."""
+"""One experiment's report: its tables as CSV and HTML, its figures, a page tying them together, and every
+run (``runs.parquet``, ``runs.csv``) and frame (``frames.parquet``) as tidy tables
+(:mod:`replication.runner.results`)."""
 
 import json
 import platform
@@ -21,6 +23,7 @@ from replication.report.tables import TableKind
 from replication.report.verdict import RULES, Verdict
 from replication.run import Run
 from replication.runner.config import experiment_at_scale
+from replication.runner.results import frames, tidy, write
 from replication.runner.store import Store
 
 
@@ -32,7 +35,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     records = store.load(runs)
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, built = [], [], {}
+    tables, figures, built, files = [], [], {}, []
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -49,7 +52,12 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             draw(records, figure_spec, experiment, out / file)
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link})
-        records.drop(columns=["per_frame", "strip", "tracks"], errors="ignore").to_csv(out / "runs.csv", index=False)
+        write(tidy(records, runs), out / "runs")
+        files += ["runs.parquet", "runs.csv"]
+        per_frame = frames(records, runs)
+        if len(per_frame):  # no CSV: up to 10^5 rows at quick scale, 10^6 at paper scale (bis_pf)
+            write(per_frame, out / "frames", csv=False)
+            files.append("frames.parquet")
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}
     verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
@@ -68,6 +76,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             n_records=len(records),
             n_runs=len(runs),
             tables=tables,
+            files=files,
             scenes=_scenes(experiment),
             figures=figures,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])

@@ -28,8 +28,8 @@ from replication.metrics.mot import BOX, clear_mot_matches
 from replication.report.figures import parse_condition
 from replication.report.style import method_label, save
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
+from replication.tasks.mot import frame_table
 
-COLUMNS = ["frame", "id", *BOX]
 # tab10 then Dark2, both without their grey (kept for the ignore regions) and without light tints (which
 # would read as the white truth): 16 saturated colours, consecutive ids (mostly alive at the same time)
 # in different hues
@@ -42,11 +42,6 @@ OUTLINE = [patheffects.withStroke(linewidth=1.6, foreground="black")]  # an id's
 def track_colour(track_id: int) -> tuple[float, float, float]:
     """The colour of track ``track_id`` (RGB in 0..1) on every figure: it depends on the id alone."""
     return ID_COLOURS[(int(track_id) - 1) % len(ID_COLOURS)]
-
-
-def tracks_table(run) -> pd.DataFrame:
-    """A run's ``tracks`` rows as a table with columns frame, id, x, y, w, h."""
-    return pd.DataFrame(list(run["tracks"]), columns=COLUMNS).astype({"frame": int, "id": int})
 
 
 def scene_key(condition: str) -> str:
@@ -144,7 +139,7 @@ def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: P
         sequence = mot_sequence(experiment, condition)
         runs = [run for _, run in _first_runs(group).iterrows()]
         frames = _snapshot_frames(spec, scene_key(condition), runs[0], sequence.n_frames)
-        tracks = [tracks_table(run) for run in runs]
+        tracks = [frame_table(run) for run in runs]
         window = _window(spec, sequence, frames, [sequence.truth, sequence.ignored, *tracks])
         for run, table in zip(runs, tracks):
             label = textwrap.fill(method_label(experiment, run["method"]), 24)
@@ -185,7 +180,7 @@ def timeline_matches(sequence: MotSequence, run) -> tuple[pd.DataFrame, pd.DataF
     (:func:`replication.metrics.mot.clear_mot_matches`, as the metrics count them)."""
     first, last = int(run["first_frame"]), int(run["last_frame"])
     truth = _between(sequence.truth, first, last)
-    tracks, ignored = _between(tracks_table(run), first, last), _between(sequence.ignored, first, last)
+    tracks, ignored = _between(frame_table(run), first, last), _between(sequence.ignored, first, last)
     matches = clear_mot_matches(truth, tracks, ignored)
     return truth, matches
 
@@ -330,7 +325,7 @@ def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path)
     first, last = spec.get("frames", (int(run["first_frame"]), int(run["first_frame"]) + 99))
     first = max(int(first), int(run["first_frame"]), 1)
     last = min(int(last), int(run["last_frame"]), sequence.n_frames)
-    tracks = tracks_table(run)
+    tracks = frame_table(run)
     animation = path.parent / spec.get("link", path.with_suffix(".gif").name)
     frames = [video_frame(sequence, k, tracks, spec.get("width", 384)) for k in range(first, last + 1)]
     write_gif(frames, animation, spec.get("fps", sequence.frame_rate))

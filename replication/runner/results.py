@@ -1,15 +1,31 @@
-"""An experiment's stored runs as one tidy table: a row per run, a column per metric and per parameter.
+"""Tidy tables of an experiment's stored runs: a row per run (:func:`load_runs`) or frame (:func:`load_frames`).
 
 ``load_runs("ism_pf", scale="quick")`` expands the experiment as the runner does and reads the
-records the store holds for it.  Every parameter of a run gets its own column, swept or fixed:
-``method.<key>`` for the method's (``method.n_particles``), ``model.<key>`` for the model's and
-its scene's, nested keys joined by dots (``model.scene_spec.frames``).  Per-frame series
-(``per_frame``, ``strip``, a MOT run's ``tracks``) stay out of the table, in the JSON records.
+records the store holds for it: a row per run, a column per metric and per parameter, swept or
+fixed: ``method.<key>`` for the method's (``method.n_particles``), ``model.<key>`` for the model's
+and its scene's, nested keys joined by dots (``model.scene_spec.frames``).  Per-frame series
+(``per_frame``, a MOT run's ``tracks``: :func:`load_frames`; ``strip``, a marginal density per
+frame, in the records only) stay out of it.
+
+``load_frames("hspf", scale="quick")`` is the per-frame table of a tracking or MOT experiment,
+a row per run and frame, with the run's identity (``experiment``, ``method``, ``condition``,
+``repetition``, ``run_key``, ``scene``) and what its task's ``frame_table`` reads from the record
+(:func:`replication.tasks.tracking.frame_table`: a row per target, its box and the frame's
+errors; :func:`replication.tasks.mot.frame_table`: a row per track, its box).  Join the two on
+``run_key`` for parameters.
 
     import seaborn as sns
     runs = load_runs("ism_pf", scale="quick")
     sns.pointplot(runs, x="method.n_particles", y="mean_cle", hue="method")
+    frames = load_frames("hspf", scale="quick")
+    sns.lineplot(frames, x="frame", y="cle", hue="method", units="run_key", estimator=None)
+
+The report writes both (:func:`write`) as ``reports/<experiment>/runs.parquet`` with
+``runs.csv``, and ``frames.parquet`` (no CSV: up to a million rows at paper scale).
 """
+
+import json
+from pathlib import Path
 
 import pandas as pd
 from hydra import compose, initialize_config_dir
@@ -18,8 +34,10 @@ from replication.paths import CONF_DIR, resolve
 from replication.run import Run
 from replication.runner.config import expand
 from replication.runner.store import Store
+from replication.tasks import TASKS
 
 SERIES = ("per_frame", "strip", "tracks")  # per-frame data, kept in the records
+IDENTITY = ("experiment", "method", "condition", "repetition", "run_key")
 
 
 def parameters(run: Run) -> dict:
@@ -28,18 +46,68 @@ def parameters(run: Run) -> dict:
     return {"run_key": run.key, **flat.iloc[0].to_dict()}
 
 
+def tidy(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
+    """The ``records`` of ``runs`` (:meth:`Store.load`) without their series, with a column per parameter:
+    the run's identity first, then its parameters, then its metrics and provenance."""
+    if records.empty:
+        return records
+    table = pd.DataFrame([parameters(run) for run in runs]).drop_duplicates("run_key")
+    records = records.drop(columns=[c for c in SERIES if c in records])
+    by_part = sorted(table, key=lambda column: column.split(".")[0])  # method.* before model.*
+    columns = dict.fromkeys([*IDENTITY, "run_id", *by_part, *records])  # in that order, each once
+    return records.merge(table, on="run_key", how="left", validate="many_to_one")[list(columns)]
+
+
+def frames(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
+    """The per-frame rows of the ``records`` of ``runs``, each with its run's identity; empty for a
+    task without per-frame data (``scalar``)."""
+    by_id = {run.run_id: run for run in runs}
+    tables = []
+    for record in records.to_dict("records"):
+        run = by_id[record["run_id"]]
+        if hasattr(TASKS[run.task], "frame_table"):
+            table = TASKS[run.task].frame_table(record)
+            identity = {**{key: record[key] for key in IDENTITY}, "scene": run.model["scene"]}
+            tables.append(table.assign(**identity)[[*identity, *table.columns]])
+    return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def write(table: pd.DataFrame, path: Path, csv: bool = True) -> None:
+    """``table`` as ``<path>.parquet`` and, with ``csv``, ``<path>.csv``: the same table in both.
+
+    A list or mapping (``method.max_velocity``, ``model.scene_spec.targets``) is written as its JSON
+    text: a CSV cell holds no list, and a Parquet column cannot hold both a list and a word (a
+    scene's ``track``: ``[0, 2]`` or ``all``).
+    """
+    nested = [c for c in table if table[c].dtype == object and table[c].map(_nested).any()]
+    table = table.assign(**{c: table[c].map(lambda v: json.dumps(v) if _nested(v) else v) for c in nested})
+    table.to_parquet(path.with_suffix(".parquet"), index=False)
+    if csv:
+        table.to_csv(path.with_suffix(".csv"), index=False)
+
+
 def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
     """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics.
 
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
     yet stored are absent (run the experiment first).
     """
+    return tidy(*_stored(experiment, scale, overrides))
+
+
+def load_frames(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
+    """Every frame of every stored run of ``experiment`` at ``scale`` (:func:`frames`); arguments as
+    :func:`load_runs`."""
+    return frames(*_stored(experiment, scale, overrides))
+
+
+def _stored(experiment: str, scale: str, overrides: tuple[str, ...]) -> tuple[pd.DataFrame, list[Run]]:
+    """The stored records of an experiment's runs, and the runs."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
     runs = expand(cfg)
-    records = Store(resolve(cfg.store), cfg.experiment.name).load(runs)
-    if records.empty:
-        return records
-    table = pd.DataFrame([parameters(run) for run in runs]).drop_duplicates("run_key")
-    records = records.drop(columns=[c for c in SERIES if c in records])
-    return records.merge(table, on="run_key", how="left", validate="many_to_one")
+    return Store(resolve(cfg.store), cfg.experiment.name).load(runs), runs
+
+
+def _nested(value) -> bool:
+    return isinstance(value, (list, dict))

@@ -2,7 +2,9 @@
 
 A task is a module with ``check(model, method)`` (raise ``ValueError`` for a
 bad config, :class:`DataMissing` for absent data) and ``run(run) -> dict``; the
-experiment config names it with ``task:``.
+experiment config names it with ``task:``.  A task whose records hold per-frame data
+also has ``frame_table(record) -> DataFrame``, a row per frame (and target or track), which
+:func:`replication.runner.results.frames` gathers.
 """
 
 from replication.scenes.factory import SequenceMissing as DataMissing

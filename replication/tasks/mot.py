@@ -36,6 +36,7 @@ from replication.vision.histogram import ColourHistogram
 
 SCENE_KEYS = {"kind", "name", "root", "first", "last", "stand_in"}
 MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal", "min_iou"}
+TRACK_COLUMNS = ["frame", "id", *BOX]  # a row of the record's ``tracks``
 
 
 @lru_cache(maxsize=4)
@@ -102,7 +103,7 @@ def run(run: Run) -> dict:
         for frame, ids, boxes in tracker.track(sequence, frames, run.rng("filter"))
         for i, box in zip(ids, boxes)
     ]
-    tracks = pd.DataFrame(rows, columns=["frame", "id", *BOX]).round(1).astype({"frame": int, "id": int})  # as stored
+    tracks = pd.DataFrame(rows, columns=TRACK_COLUMNS).round(1).astype({"frame": int, "id": int})  # as stored
     truth, ignored = (table[table["frame"].isin(frames)] for table in (sequence.truth, sequence.ignored))
     min_iou = run.model.get("min_iou", 0.5)
     kept = drop_ignored(tracks, truth, ignored, min_iou)  # once, for every metric below
@@ -123,3 +124,9 @@ def run(run: Run) -> dict:
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),
     }
+
+
+def frame_table(record: dict) -> pd.DataFrame:
+    """A run's ``tracks`` as rows (frame, id): the MOT frame number (from 1), the track's id (from 1)
+    and its box (x, y, w, h, top-left from 0)."""
+    return pd.DataFrame(list(record["tracks"]), columns=TRACK_COLUMNS).astype({"frame": int, "id": int})

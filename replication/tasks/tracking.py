@@ -12,12 +12,14 @@ JPEG decoding), which the papers' videos did not pay for.
 """
 
 import numpy as np
+import pandas as pd
 
 from replication.filters import build_filter
 from replication.filters.tracker import Adaptation, Marginal
 from replication.filters.tracker import tracker as make_tracker
 from replication.metrics import multi
 from replication.metrics import tracking as tm
+from replication.metrics.mot import BOX
 from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
 from replication.run import Run
@@ -187,3 +189,21 @@ def run(run: Run) -> dict:
     if collectors["alpha"].value is not None:  # fusion_pf's alpha_k, first target
         record["per_frame"]["alpha"] = [None] + np.round(collectors["alpha"].value, 4).tolist()
     return record
+
+
+def frame_table(record: dict) -> pd.DataFrame:
+    """A run's ``per_frame`` series as rows (frame, target): the target's estimated box (x, y, w, h;
+    at frame 0 the true box it was given) and the frame's ``cle``, ``iou``, ``dx``, ``dy`` and
+    ``ess`` (NaN at frame 0), means over the run's targets, and fusion_pf's ``alpha`` (its first
+    target's), as the record holds them: the same on every target's row of a multi-target run.
+    Frames count from 0, the first of the run's sequence."""
+    series = record["per_frame"]
+    boxes = np.asarray(series["box"], dtype=float)  # (T, M, 4)
+    n_frames, n_targets = boxes.shape[:2]
+    table = pd.DataFrame({"frame": np.repeat(np.arange(n_frames), n_targets),
+                          "target": np.tile(series["targets"], n_frames)})
+    table[BOX] = boxes.reshape(-1, 4)
+    for name, values in series.items():
+        if name not in ("box", "targets"):
+            table[name] = np.repeat(np.asarray(values, dtype=float), n_targets)
+    return table
