@@ -1,16 +1,100 @@
-"""Reproducible replication of five particle-filter papers on visual tracking.
+"""Reproducible replication of five particle-filter papers on visual tracking, and the filters as a library.
 
-``replication.load_runs(experiment, scale)``: an experiment's stored runs as one tidy table
-(:mod:`replication.runner.results`), imported on first use so that ``import replication`` stays light.
+Everything a user needs to run the filters on their own model or video is a
+top-level name, ``from replication import bootstrap, kalman_filter, VideoSequence``:
+
+* the SMC core (:mod:`replication.smc`): :class:`ParticleFilter`, the one
+  propose -> move -> weight -> estimate -> resample loop, which takes any
+  :class:`StateSpaceModel` (``sample_initial``, ``propagate``, ``log_likelihood``);
+  its :class:`ResamplingPolicy` and the resampling schemes; ESS and weight helpers;
+* the filters (:mod:`replication.filters`): every builder of the :data:`FILTERS`
+  registry (:func:`bootstrap` and the five papers' variants), :func:`build_filter`
+  to make one from config keys, and :func:`tracker` to step one or many targets
+  through frames;
+* models (:mod:`replication.models`): :class:`LinearGaussian` with its exact
+  :func:`kalman_filter`, :class:`UNGM`, :class:`AdditiveGaussianModel` to derive
+  your own scalar model from, :class:`BoxModel` for a target's box in video;
+* observation models (:mod:`replication.vision`): :class:`ColourHistogram`,
+  :class:`ColourLikelihood`, :class:`FusionLikelihood`, the Bhattacharyya coefficient;
+* metrics (:mod:`replication.metrics`): OTB precision and success, CLEAR MOT,
+  IDF1, HOTA, RMSE and filter diagnostics;
+* sequences (:mod:`replication.scenes`): :class:`VideoSequence` (any video file),
+  :class:`OTBSequence`, :func:`load_mot`, :class:`SyntheticScene`;
+* :func:`load_runs`, :func:`load_frames`: an experiment's stored runs (and their frames) as tidy tables.
+
+Each name is imported from its module on first use (PEP 562), so ``import replication``
+itself loads neither numpy nor OpenCV and the command line answers at once.  The
+tutorials are ``docs/tutorial_state_space.md`` and ``docs/tutorial_video.md``.
 """
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "load_runs"]
+
+_EXPORTS = {  # module: the public names it defines, in the order of the API reference
+    "replication.smc.loop": (
+        "ParticleFilter", "StateSpaceModel", "ResamplingPolicy", "FilterOutput", "Proposal", "Move",
+    ),
+    "replication.smc.resampling": ("RESAMPLERS", "multinomial", "residual", "stratified", "systematic"),
+    "replication.smc.weights": ("ess", "normalise", "weighted_mean", "weighted_variance"),
+    "replication.filters": ("FILTERS", "build_filter"),
+    "replication.filters.bootstrap": ("bootstrap",),
+    "replication.filters.point_mass": ("PointMassFilter",),
+    "replication.filters.pso": ("pso",),
+    "replication.filters.ism": ("ism",),
+    "replication.filters.qmc": ("nqmcpf", "gps_qmcpf", "tr_sqmc"),
+    "replication.filters.harmony": ("hspf", "hs"),
+    "replication.filters.mean_shift": ("ms", "mspf"),
+    "replication.filters.bis": ("MIPF", "BISPF", "MRFJPF"),
+    "replication.filters.mean_field": ("MFMC",),
+    "replication.filters.dmot": ("DMOT",),
+    "replication.filters.mcmc": ("MCMCPF",),
+    "replication.filters.opencv_trackers": ("mil", "dft"),
+    "replication.filters.open_tracker": ("sort_tracker", "detections_only_tracker"),
+    "replication.filters.tracker": ("tracker", "Tracker"),
+    "replication.models": ("MODELS",),
+    "replication.models.additive": ("AdditiveGaussianModel",),
+    "replication.models.linear_gaussian": ("LinearGaussian", "kalman_filter"),
+    "replication.models.ungm": ("UNGM",),
+    "replication.models.point_mass": ("point_mass_filter",),
+    "replication.models.box": ("BoxModel",),
+    "replication.models.boosted": ("BoostedBoxModel",),
+    "replication.vision.histogram": ("ColourHistogram", "hsv_bin_image"),
+    "replication.vision.colour": ("ColourLikelihood",),
+    "replication.vision.fusion": ("FusionLikelihood",),
+    "replication.vision.likelihood": (
+        "bhattacharyya", "bhattacharyya_distance", "gaussian_similarity_log_likelihood",
+    ),
+    "replication.vision.ssim": ("structural_similarity",),
+    "replication.metrics.scalar": ("rmse", "filter_diagnostics"),
+    "replication.metrics.tracking": (
+        "centre_error", "iou", "precision_curve", "precision_at", "success_curve", "success_auc",
+    ),
+    "replication.metrics.multi": ("clear_mot", "idf1"),
+    "replication.metrics.mot": ("mot_metrics",),
+    "replication.metrics.hota": ("hota",),
+    "replication.scenes.base": ("Sequence",),
+    "replication.scenes.video": ("VideoSequence",),
+    "replication.scenes.otb": ("OTBSequence", "find_otb"),
+    "replication.scenes.mot": ("MotSequence", "load_mot"),
+    "replication.scenes.synthetic": ("SyntheticScene",),
+    "replication.scenes.export": ("write_sequence",),
+    "replication.errors": ("ConfigError",),
+    "replication.runner.results": ("load_runs", "load_frames"),
+}
+_MODULE_OF = {name: module for module, names in _EXPORTS.items() for name in names}
+
+__all__ = ["__version__", *_MODULE_OF]  # noqa: PLE0604 (the names of _EXPORTS, written once)
 
 
 def __getattr__(name: str):
-    if name == "load_runs":
-        from replication.runner.results import load_runs
+    """Import a public name's module on first use and keep the name here (PEP 562)."""
+    from importlib import import_module
 
-        return load_runs
-    raise AttributeError(f"module 'replication' has no attribute {name!r}")
+    if name not in _MODULE_OF:
+        raise AttributeError(f"module 'replication' has no attribute {name!r}")
+    value = getattr(import_module(_MODULE_OF[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
