@@ -89,25 +89,12 @@ def test_identical_outcomes_are_no_difference_not_a_win():
     assert verdict.outcome is Outcome.NOT_REPRODUCED and "no difference" in verdict.why
 
 
-def test_threshold_and_best():
+def test_threshold():
     records = _records({"A": 0.0, "B": 1.0}, metric="fps")
     assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 2.0,
                      "statistic": "median"}, records).outcome is Outcome.REPRODUCED
     assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 50.0},
                     records).outcome is Outcome.NOT_REPRODUCED
-    sequences = pd.DataFrame([{"method": m, "condition": f"scene={s}", "precision20": score}
-                              for s in range(6) for m, score in (("A", 0.9), ("B", 0.5 + 0.01 * s))])
-    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, sequences).outcome \
-        is Outcome.REPRODUCED
-    assert _verdict({"test": "best", "metric": "precision20", "method": "B"}, sequences).outcome \
-        is Outcome.NOT_REPRODUCED
-    split = sequences.assign(precision20=[0.9 if (s % 2 == 0) == (m == "A") else 0.5
-                                          for s, m in zip(sequences["condition"].str[-1].astype(int),
-                                                          sequences["method"])])
-    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, split).outcome \
-        is Outcome.INCONCLUSIVE
-    assert _verdict({"test": "best", "metric": "precision20", "method": "A"}, sequences.iloc[:8]).outcome \
-        is Outcome.NOT_TESTABLE  # four sequences
 
 
 def test_result_combines_checks():

@@ -6,6 +6,11 @@ from replication.report.quantities import quantity
 from replication.report.statistics import estimate
 
 
+def parse_condition(condition: str) -> dict[str, str]:
+    """A run's condition as {variable: value}: 'scene=Girl;N=10' -> {'scene': 'Girl', 'N': '10'}."""
+    return dict(part.split("=", 1) for part in condition.split(";") if part)
+
+
 def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic: str = "mean") -> pd.DataFrame:
     """One row per (method, condition): runs, the statistic, its 95% interval (``ci_low``, ``ci_high``),
     how the interval was made, and the variance over runs.  ``scale`` converts units (100: a percentage)."""

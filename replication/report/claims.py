@@ -11,7 +11,7 @@ A reading names an experiment and a *test*, a small class registered by
 name (:class:`ClaimTest`): ``order`` (paired differences between methods on
 common random numbers), ``cells`` (the verdicts of published cells in named
 tables), ``threshold`` (a statistic against a bound), ``best`` (a method
-first over several sequences, with its bootstrap stability) and
+first over several sequences, decided by its probability of ranking first) and
 ``uniformity`` (discrepancies of point sets, no runs).  Each test returns
 :class:`Check` values, combined into the reading's :class:`Result`.
 """
@@ -30,12 +30,17 @@ import yaml
 from replication.paths import CONF_DIR
 from replication.qmc import discrepancy_table
 from replication.report.quantities import quantity
-from replication.report.statistics import SEED, Estimate, estimate, paired_difference
+from replication.report.ranking import rankings, unreliable
+from replication.report.statistics import Estimate, estimate, paired_difference
 from replication.report.tables import Table, pair
 from replication.report.verdict import Outcome, Verdict, too_few
 
 CLAIMS_DIR = CONF_DIR / "claims"
-STABLE = 0.95  # a ranking "holds" when the method is first in this share of bootstrap resamples
+# A "best" claim holds when the method ranks first in at least 95% of the bootstrap resamples (the level
+# of every interval here) and fails when it does in at most 5% (so also when another method's P(best) is
+# at least 0.95); between, the sequences and runs leave it open.
+FIRST = 0.95
+NOT_FIRST = 0.05
 
 
 @dataclass(frozen=True)
@@ -240,35 +245,39 @@ class Threshold(ClaimTest):
 
 
 class Best(ClaimTest):
-    """``method`` has the best mean ``metric`` over the sequences (conditions), and how stable that is:
-    the share of bootstrap resamples of the sequences (with replacement) in which it is still first."""
+    """``method`` ranks first in mean ``metric`` over the sequences (the condition variable ``over``,
+    default ``scene``; ``group``: one value of the ranking's ``by`` variable), decided by its probability
+    of ranking first under the two-level bootstrap of :mod:`replication.report.ranking`, not by the
+    means: reproduced at ``P(best) >=`` :data:`FIRST`, not reproduced at ``<=`` :data:`NOT_FIRST` (which
+    also holds whenever another method's is at least :data:`FIRST`), inconclusive between.  A ranking
+    that is not reliable (too few runs or sequences, sequences cut short) decides nothing."""
 
     name = "best"
-    MIN_SEQUENCES = 5
 
     def checks(self, records, tables):
         metric, method = self.spec["metric"], self.spec["method"]
-        means = records.pivot_table(index="condition", columns="method", values=metric, aggfunc="mean").dropna()
-        if method not in means or len(means) == 0:
+        found = rankings(records, self.spec).get(self.spec.get("group", ""))
+        if found is None or method not in found.methods:
             return []
-        scores = means.to_numpy() if not quantity(metric).lower_is_better else -means.to_numpy()
-        column = list(means.columns).index(method)
-        rng = np.random.default_rng(SEED)
-        draws = rng.integers(0, len(means), size=(2000, len(means)))
-        first = scores[draws].mean(axis=1).argmax(axis=1) == column
-        share = float(first.mean())
-        leader = means.columns[scores.mean(axis=0).argmax()]
-        what = f"{method} first in mean {metric} over {len(means)} sequences (ours: {leader})"
-        if len(means) < self.MIN_SEQUENCES:
-            verdict = Verdict(Outcome.NOT_TESTABLE, f"too few sequences ({len(means)})")
-        elif share >= STABLE:
-            verdict = Verdict(Outcome.REPRODUCED, f"first in {share:.0%} of resamples")
-        elif share <= 1 - STABLE:
-            verdict = Verdict(Outcome.NOT_REPRODUCED, f"first in {share:.0%} of resamples")
+        i, top = found.index(method), int(np.argmax(found.p_best))
+        p = float(found.p_best[i])
+        what = (f"{method} first in mean {metric} over {len(found.sequences)} sequences x {found.runs} "
+                f"run(s): P(best), two-level bootstrap")
+        rank = found.rank(i)
+        leader = f"; first most often: {found.methods[top]} ({found.p_best[top]:.2f})" if top != i else ""
+        caveat = unreliable(found, self.experiment)
+        if caveat:
+            outcome, against = Outcome.NOT_TESTABLE, ""
+        elif p >= FIRST:
+            outcome, against = Outcome.REPRODUCED, f" >= {FIRST}"
+        elif p <= NOT_FIRST:
+            outcome, against = Outcome.NOT_REPRODUCED, f" <= {NOT_FIRST}"
         else:
-            verdict = Verdict(Outcome.INCONCLUSIVE, f"first in {share:.0%} of resamples")
-        return [Check(what, verdict, Estimate(share, math.nan, math.nan, len(means), "bootstrap over sequences"),
-                      " of resamples first", STABLE)]
+            outcome, against = Outcome.INCONCLUSIVE, f", between {NOT_FIRST} and {FIRST}"
+        said = f"P(best) = {p:.2f}{against}, rank [{rank.low:.0f}, {rank.high:.0f}]{leader}"
+        verdict = Verdict(outcome, f"{caveat}; {said}" if caveat else said)
+        estimate = Estimate(p, math.nan, math.nan, len(found.sequences) * found.runs, "two-level bootstrap")
+        return [Check(what, verdict, estimate, reference=FIRST)]
 
 
 class Uniformity(ClaimTest):

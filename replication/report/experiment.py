@@ -46,12 +46,15 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             table.written().to_csv(out / csv, index=False)
             html = html_table(table.shown())
             (out / f"{table_spec['name']}.html").write_text(html)
-            tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv})
+            tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv,
+                           "note": table.note})
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
             draw(records, figure_spec, experiment, out / file)
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
-            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link})
+            beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
+            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link,
+                            **beside})
         write(tidy(records, runs), out / "runs")
         files += ["runs.parquet", "runs.csv"]
         per_frame = frames(records, runs)
@@ -104,7 +107,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         "cells": compared,
         "claims": claims,
         "scale_changes": changes,
-        "tables": [{k: t[k] for k in ("name", "title", "csv")} for t in tables],
+        "tables": [{k: t[k] for k in ("name", "title", "csv", "note")} for t in tables],
         "figures": figures,
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=1))

@@ -13,7 +13,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
-from replication.report.aggregate import summarise  # noqa: E402
+from replication.report.aggregate import parse_condition, summarise  # noqa: E402
 from replication.report.published import cells, load_published  # noqa: E402
 from replication.report.style import (  # noqa: E402
     BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
@@ -21,10 +21,6 @@ from replication.report.style import (  # noqa: E402
 )
 
 PLAIN = FuncFormatter(lambda value, _: f"{value:g}")  # 0.1, 20, 500 rather than powers of ten
-
-
-def parse_condition(condition: str) -> dict[str, str]:
-    return dict(part.split("=", 1) for part in condition.split(";") if part)
 
 
 def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
@@ -198,6 +194,7 @@ def _legend(ax) -> int:
 def _figures():
     from replication.report.mot_figures import identity_timeline, track_snapshots, track_video
     from replication.report.qmc_figures import point_sets
+    from replication.report.ranking_figures import ranking
     from replication.report.tracking_figures import (
         attribute_map, mode_strip, otb_curves, per_frame_curve, snapshots, track,
     )
@@ -214,6 +211,7 @@ def _figures():
         "track_snapshots": track_snapshots,
         "identity_timeline": identity_timeline,
         "track_video": track_video,
+        "ranking": ranking,
     }
 
 

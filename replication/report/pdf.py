@@ -82,7 +82,8 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
             heading = summary.get("title", name)
             for table in _tables(reports / name, summary, configs.get(name, {})):
                 frame = _shown(pd.read_csv(reports / name / table["csv"]))
-                _table_pages(pdf, heading, frame, subtitle=table["title"], font=TABLE_FONT)
+                subtitle = " ".join(filter(None, [table["title"], table.get("note")]))
+                _table_pages(pdf, heading, frame, subtitle=subtitle, font=TABLE_FONT)
             for figure in _figures(reports / name, summary, configs.get(name, {})):
                 _figure_page(pdf, heading, figure["title"], reports / name / figure["file"])
         info = pdf.infodict()

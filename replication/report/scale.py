@@ -39,5 +39,5 @@ def scale_note(scale: str, changes: list[str] | None = None) -> str | None:
         return None
     listed = "" if changes is None else f" ({'; '.join(changes) or 'for this experiment, nothing'})"
     return (f"Quick scale: fewer runs and shorter scenes than the papers'{listed}. Intervals are wider, "
-            f"verdicts from fewer than 5 runs are 'not testable', and rankings over truncated sequences can "
-            f"differ from full-length ones. Paper scale: {PAPER_COMMAND}.")
+            f"verdicts from fewer than 5 runs are 'not testable', and a ranking over sequences cut short is "
+            f"marked not reliable and decides no claim (a full-length ranking can differ). Paper scale: {PAPER_COMMAND}.")

@@ -9,6 +9,7 @@ Add a kind by subclassing :class:`TableKind` with a new ``kind`` name and a
 ``build`` method; a spec in ``report.tables`` then names it.
 """
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -22,6 +23,7 @@ from replication.report.attributes import attribute_scores, carried_by
 from replication.report.modes import runs_keeping_both_modes
 from replication.report.published import cells
 from replication.report.quantities import quantity
+from replication.report.ranking import Ranking, rankings, unreliable
 from replication.report.statistics import Estimate, paired_difference, proportion
 from replication.report.verdict import Outcome, Verdict, judge_band, judge_value, too_few
 
@@ -31,11 +33,13 @@ KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
 
 @dataclass
 class Table:
-    """Rows of ours (``frame``: numbers, and a Verdict per row where compared) and the published cells
-    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell)."""
+    """Rows of ours (``frame``: numbers, and a Verdict per row where compared), the published cells
+    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), and a
+    line a reader must see beside it (``note``: a ranking that is not reliable)."""
 
     frame: pd.DataFrame
     cells: list[dict] = field(default_factory=list)
+    note: str = ""
 
     @property
     def empty(self) -> bool:
@@ -330,6 +334,50 @@ class Discrepancy(TableKind):
         spec = self.spec
         return Table(discrepancy_table(n=int(spec.get("n", 400)), dims=tuple(spec.get("dims", (2, 3, 5))),
                                        method=spec.get("method", "CD")))
+
+
+def _note(found: dict[str, Ranking], experiment: dict) -> str:
+    """The line under a ranking that is not reliable ('' when every ranking of the table is)."""
+    said = "; ".join(dict.fromkeys(filter(None, (unreliable(r, experiment) for r in found.values()))))
+    if not said:
+        return ""
+    return f"{said[:1].upper()}{said[1:]}: the probabilities describe these runs and decide no claim."
+
+
+class RankingTable(TableKind):
+    """Methods ranked by their mean ``metric`` over the sequences, best first, with how stable that is
+    (:mod:`replication.report.ranking`): the mean over the sequences (95% percentile interval of the
+    two-level bootstrap), the probability of ranking first, and the mean rank with its 95% interval."""
+
+    kind = "ranking"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        found = rankings(records, self.spec)
+        rows = [{"condition": group or "-", "method": self.label(method), "sequences": len(ranked.sequences),
+                 "runs": ranked.runs, self.spec["metric"]: ranked.score(i),
+                 "P(best)": round(float(ranked.p_best[i]), 3), "rank": ranked.rank(i)}
+                for group, ranked in found.items() for i, method in enumerate(ranked.methods)]
+        return Table(pd.DataFrame(rows), note=_note(found, self.experiment))
+
+
+class Pairwise(TableKind):
+    """Every pair of ranked methods, the better-ranked first: the probability that A's mean over the
+    sequences beats B's (two-level bootstrap), the mean of the paired per-sequence differences A - B
+    with its BCa interval over the sequences, and on how many sequences A is ahead."""
+
+    kind = "pairwise"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        found, metric = rankings(records, self.spec), self.spec["metric"]
+        rows = [{"condition": group or "-", "A": self.label(ranked.methods[a]),
+                 "B": self.label(ranked.methods[b]), "sequences": len(ranked.sequences), "runs": ranked.runs,
+                 "P(A beats B)": round(float(ranked.beats[a, b]), 3),
+                 f"{metric} A - B": ranked.difference(a, b), "A ahead on (sequences)": ranked.wins(a, b)}
+                for group, ranked in found.items()
+                for a, b in itertools.combinations(range(len(ranked.methods)), 2)]
+        return Table(pd.DataFrame(rows), note=_note(found, self.experiment))
 
 
 def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
