@@ -3,6 +3,7 @@
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine (reports/benchmark/)
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
+# make docs        the API reference from the docstrings (pdoc), into reports/api/
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -19,14 +20,14 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-all replicate readings report benchmark
+.PHONY: setup browser test test-all replicate readings report benchmark docs
 
 setup: $(VENV)/.installed
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
 	# TrackEval (HOTA) pulls in opencv-python beside opencv-python-headless; both unpack into cv2/.
 	# Reinstalling the headless build last makes its cv2 the one imported (no libGL or X11 needed).
 	$(BIN)/python -m pip install --quiet --force-reinstall --no-deps \
@@ -62,3 +63,7 @@ benchmark: setup
 
 report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)
+
+docs: setup
+	$(BIN)/python -m pdoc -o reports/api replication
+	@echo "API reference: reports/api/replication.html"

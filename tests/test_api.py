@@ -5,10 +5,10 @@ import sys
 import warnings
 
 import pytest
+from conftest import PROJECT_ROOT
 
 import replication
 from replication.filters import FILTERS
-from replication.paths import PROJECT_ROOT
 
 
 def test_import_replication_loads_no_numerical_library():

@@ -306,3 +306,16 @@ def test_a_multirun_draws_its_sweep_at_its_end(cli, tmp_path):
     table = pd.read_csv(page.with_suffix(".csv"))
     swept = table[table["method"] == "PF"]
     assert set(swept["condition"]) == {"n_particles=50", "n_particles=100"} and (swept["runs"] == 5).all()
+
+
+def test_tab_completion_offers_experiments_and_keys():
+    """Hydra's shell completion through the one entry point: what bash's completion function asks."""
+    def complete(line: str) -> list[str]:
+        env = {**os.environ, "COMP_LINE": line, "COMP_POINT": str(len(line))}
+        done = subprocess.run([sys.executable, "-m", "replication", "-sc", "query=bash"], cwd=PROJECT_ROOT, env=env,
+                              capture_output=True, text=True, timeout=60, check=False)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.split()
+
+    assert complete("pf-replicate experiment=hspf_u") == ["experiment=hspf_ungm", "experiment=hspf_ungm_sweep"]
+    assert "scale=" in complete("pf-replicate experiment=hspf sc")

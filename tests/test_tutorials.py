@@ -12,9 +12,10 @@ import re
 
 import numpy as np
 import pytest
+from conftest import PROJECT_ROOT
 
 import replication as rp
-from replication.paths import PROJECT_ROOT, resolve
+from replication.paths import resolve
 from replication.scenes.otb import OTB_ROOT
 
 BLOCK = re.compile(r"```(python|text)\n(.*?)```", re.DOTALL)
@@ -63,6 +64,7 @@ def test_state_space_tutorial_agrees_with_the_exact_filters():
 
 @pytest.mark.skipif(not HAVE_GIRL, reason="../shared/data/otb is not beside the project")
 def test_video_tutorial_tracks_better_than_a_box_left_still(tmp_path, monkeypatch):
+    monkeypatch.setenv("REPLICATION_HOME", str(PROJECT_ROOT))  # relative data paths: from the checkout
     monkeypatch.chdir(tmp_path)  # where the tutorial writes its video and figure
     tutorial = run_tutorial("tutorial_video.md")
     scores = tutorial["scores"]
