@@ -11,6 +11,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
+from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.claims import evaluate
 from replication.report.figures import draw
@@ -32,7 +33,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     records = store.load(runs)
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, built = [], [], {}
+    tables, figures, built, results = [], [], {}, []
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -50,6 +51,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link})
         records.drop(columns=["per_frame", "strip", "tracks"], errors="ignore").to_csv(out / "runs.csv", index=False)
+        for layout, folder in LAYOUTS.items():  # runs on real OTB sequences, for other toolkits to re-score
+            if write_results(runs, records, out / "results", layout):
+                results.append(f"results/{folder}/")
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}
     verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
@@ -70,6 +74,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             tables=tables,
             scenes=_scenes(experiment),
             figures=figures,
+            results=results,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)
             else None,

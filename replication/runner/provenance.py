@@ -3,7 +3,8 @@
 :func:`code_digest` is part of every run key, so a change to any module that
 can change a run's numbers gives new runs rather than stale ones.  It hashes
 the source of every module of the package except the report layer
-(``replication/report/``), which only reads stored records.
+(``replication/report/``) and the export (``replication/export.py``), which
+only read stored records.
 :func:`provenance` is written into every record, and the report shows it.
 """
 
@@ -16,7 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent
-READ_ONLY = ("report",)  # sub-packages that never compute a run
+READ_ONLY = ("report", "export.py")  # sub-packages and modules that never compute a run
 LIBRARIES = {"numpy": "numpy", "scipy": "scipy", "opencv": "opencv-python-headless", "numba": "numba"}  # column: distribution
 
 

@@ -28,16 +28,22 @@ def parameters(run: Run) -> dict:
     return {"run_key": run.key, **flat.iloc[0].to_dict()}
 
 
-def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
-    """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics.
+def stored_records(experiment: str, scale: str = "paper", *overrides: str) -> tuple[list[Run], pd.DataFrame]:
+    """The runs of ``experiment`` at ``scale`` and the records the store holds of them, per-frame series included.
 
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
-    yet stored are absent (run the experiment first).
+    yet stored have no record (run the experiment first).
     """
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
     runs = expand(cfg)
-    records = Store(resolve(cfg.store), cfg.experiment.name).load(runs)
+    return runs, Store(resolve(cfg.store), cfg.experiment.name).load(runs)
+
+
+def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
+    """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics
+    (``overrides`` as for :func:`stored_records`)."""
+    runs, records = stored_records(experiment, scale, *overrides)
     if records.empty:
         return records
     table = pd.DataFrame([parameters(run) for run in runs]).drop_duplicates("run_key")
