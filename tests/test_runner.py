@@ -153,6 +153,20 @@ def test_changed_config_lands_in_new_files(make_cfg, tmp_path):
     assert store.load(changed).empty
 
 
+def test_code_digest_leaves_out_the_modules_that_only_read_runs(tmp_path):
+    def digest(copy: str, *changed: str) -> str:
+        """The digest of a copy of the package with a comment added to each of ``changed``."""
+        package = tmp_path / copy / "replication"
+        shutil.copytree(PROJECT_ROOT / "replication", package, ignore=shutil.ignore_patterns("__pycache__"))
+        for module in changed:
+            with open(package / module, "a") as source:
+                source.write("# a change\n")
+        return code_digest(package)
+
+    before = digest("same")
+    assert digest("readers", "export.py", "report/render.py") == before != digest("metric", "metrics/tracking.py")
+
+
 def test_changed_code_lands_in_new_runs(tmp_path):
     """A copy of the project whose bootstrap filter differs by one comment recomputes every run; a change
     to the report layer, the command line or the reader of records reuses them.  Run through the CLI."""

@@ -42,7 +42,7 @@ class Tracker(ABC):
 
     targets: list
     models: list
-    seconds: float = 0.0  # time spent in ``step`` by ``track`` (frame production excluded)
+    frame_seconds: list[float]  # time spent in each ``step`` by ``track`` (frame production excluded)
     adapts: bool = False  # whether the models adapt at the estimates after each step
 
     @abstractmethod
@@ -64,14 +64,15 @@ class Tracker(ABC):
     def track(self, frames: Iterable, collectors: Iterable["Collector"] = ()) -> Iterator[list[np.ndarray]]:
         """Step through ``frames`` (frame 1 on), calling every collector after each step; yields the estimates.
 
-        ``seconds`` adds up the time in :meth:`step` only: producing a frame
-        (rendering, decoding) is the iterator's, and collectors are not the tracker's cost.
+        ``frame_seconds`` holds the time in :meth:`step` only, one entry per frame: producing a
+        frame (rendering, decoding) is the iterator's, and collectors are not the tracker's cost.
         """
         collectors = list(collectors)
+        self.frame_seconds = []
         for frame in frames:
             started = time.perf_counter()
             estimates = self.step(frame)
-            self.seconds += time.perf_counter() - started
+            self.frame_seconds.append(time.perf_counter() - started)
             for collector in collectors:
                 collector.collect(self)
             yield estimates

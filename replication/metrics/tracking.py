@@ -3,14 +3,33 @@
 Wu, Lim and Yang (2013/2015): centre location error (CLE), overlap (IoU),
 precision curve (share of frames with CLE <= tau, tau = 0..50 px; the score is
 its value at 20 px) and success curve (share of frames with IoU > theta,
-theta = 0, 0.05, ..., 1; the score is its mean, the AUC).  Boxes here are
-continuous, so IoU uses areas w * h (not OTB's inclusive pixel counts).
+theta = 0, 0.05, ..., 1; the score is its mean, the AUC).  OTB's toolkit
+(``calcRectInt.m``) counts pixels inclusively, an overlap of
+``min(x1 + w1 - 1, x2 + w2 - 1) - max(x1, x2) + 1`` columns, which is the
+continuous ``min(x1 + w1, x2 + w2) - max(x1, x2)`` used here, over areas w * h
+as there; its centres, ``x + (w - 1) / 2`` in 1-based pixels, are ours
+(``x + w / 2``, 0-based) shifted by the same half pixel for every box, so the
+CLE is the same.
+
+Which frames count (:data:`COUNT_FIRST_FRAME`): the one-pass evaluation starts
+from the true box in the first frame.  OTB's toolkit (``calcSeqErrRobust.m``
+sets the first result to the ground truth, ``genPerfMat.m`` divides by every
+frame) counts that frame, as does the GOT-10k toolkit's ``ExperimentOTB``;
+GOT-10k's own evaluation (``ExperimentGOT10k.report``) leaves it out.
 """
 
 import numpy as np
 
 PRECISION_THRESHOLDS = np.arange(0, 51)
 SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
+# The OTB scores count the first frame, whose box is the given truth, as OTB's toolkit does (hspf
+# evaluates on OTB sequences, its ref. [17]); False leaves it out, as GOT-10k's evaluation does.
+COUNT_FIRST_FRAME = True
+
+
+def scored_frames(per_frame: np.ndarray, count_first_frame: bool = COUNT_FIRST_FRAME) -> np.ndarray:
+    """The frames (first axis) of a one-pass run that the OTB scores count; see :data:`COUNT_FIRST_FRAME`."""
+    return np.asarray(per_frame)[0 if count_first_frame else 1 :]
 
 
 def centres(boxes: np.ndarray) -> np.ndarray:

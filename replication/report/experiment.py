@@ -13,6 +13,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
+from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.claims import evaluate
 from replication.report.figures import draw
@@ -35,7 +36,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     records = store.load(runs)
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, built, files = [], [], {}, []
+    tables, figures, built, files, results = [], [], {}, [], []
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -61,6 +62,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         if len(per_frame):  # no CSV: up to 10^5 rows at quick scale, 10^6 at paper scale (bis_pf)
             write(per_frame, out / "frames", csv=False)
             files.append("frames.parquet")
+        for layout, folder in LAYOUTS.items():  # runs on real OTB sequences, for other toolkits to re-score
+            if write_results(runs, records, out / "results", layout):
+                results.append(f"results/{folder}/")
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}
     verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
@@ -82,6 +86,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             files=files,
             scenes=_scenes(experiment),
             figures=figures,
+            results=results,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)
             else None,

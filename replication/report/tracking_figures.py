@@ -196,16 +196,17 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
 def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """OTB one-pass precision and success plots over every sequence and run, one line per method.
 
-    Each curve is the mean over runs of the per-run curve (frames after the
-    given first one), so long sequences weigh more, as in the OTB benchmark;
-    the legend gives precision at 20 px and the success AUC.
+    Each curve is the mean over runs of the per-run curve (the frames
+    :func:`~replication.metrics.tracking.scored_frames` counts), so every
+    sequence weighs the same, as in OTB's toolkit; the legend gives precision
+    at 20 px and the success AUC.
     """
     from replication.metrics import tracking as tm
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
     for method, runs in records.groupby("method", sort=False):
-        errors = [np.asarray(r["cle"][1:], dtype=float) for r in runs["per_frame"]]
-        overlaps = [np.asarray(r["iou"][1:], dtype=float) for r in runs["per_frame"]]
+        errors = [tm.scored_frames(np.asarray(r["cle"], dtype=float)) for r in runs["per_frame"]]
+        overlaps = [tm.scored_frames(np.asarray(r["iou"], dtype=float)) for r in runs["per_frame"]]
         precision = np.mean([tm.precision_curve(e) for e in errors], axis=0)
         success = np.mean([tm.success_curve(o) for o in overlaps], axis=0)
         label, line = method_label(experiment, method), method_look(method).line()

@@ -92,16 +92,16 @@ def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.Data
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
     yet stored are absent (run the experiment first).
     """
-    return tidy(*_stored(experiment, scale, overrides))
+    return tidy(*stored_records(experiment, scale, *overrides))
 
 
 def load_frames(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
     """Every frame of every stored run of ``experiment`` at ``scale`` (:func:`frames`); arguments as
     :func:`load_runs`."""
-    return frames(*_stored(experiment, scale, overrides))
+    return frames(*stored_records(experiment, scale, *overrides))
 
 
-def _stored(experiment: str, scale: str, overrides: tuple[str, ...]) -> tuple[pd.DataFrame, list[Run]]:
+def stored_records(experiment: str, scale: str = "paper", *overrides: str) -> tuple[pd.DataFrame, list[Run]]:
     """The stored records of an experiment's runs, and the runs."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])

@@ -8,7 +8,10 @@ so the frame's features are computed once for all targets.  A synthetic
 scene's ``scene_seed`` says whether every run sees the configured video
 (``fixed``) or the repetition draws its own (``per_run``).  Timings are per
 frame for all targets together and exclude producing the frame (rendering or
-JPEG decoding), which the papers' videos did not pay for.
+JPEG decoding), which the papers' videos did not pay for.  The OTB scores
+(precision at 20 px, success AUC) count the given first frame or not as
+:data:`replication.metrics.tracking.COUNT_FIRST_FRAME` says; the filter's own
+averages (mean CLE, shares of correct frames) are over the frames it filtered.
 """
 
 import numpy as np
@@ -144,7 +147,7 @@ def run(run: Run) -> dict:
         collectors["strip"] = Marginal(chosen.index(strip["target"]), axis, strip.get("bins", 60), sequence.size["xy".index(axis)])
     for _ in tracker.track((sequence.frame(k) for k in range(1, sequence.n_frames)), collectors.values()):
         pass
-    seconds = tracker.seconds
+    seconds = sum(tracker.frame_seconds)
     outputs = tracker.outputs()
     diagnostics = [filter_diagnostics(output) for output in outputs]
     boxes = [BoxModel.boxes(output.means) for output in outputs]
@@ -152,12 +155,12 @@ def run(run: Run) -> dict:
     truth = sequence.truth[:, chosen]
     errors, overlaps = tm.centre_error(estimates, truth), tm.iou(estimates, truth)  # (T, M)
     deviation = tm.deviation(estimates, truth)
-    scored = slice(1, None)  # frame 0 is given
+    filtered = slice(1, None)  # frame 0 is given
     record = {
         "frames": sequence.n_frames,
-        "mean_cle": float(errors[scored].mean()),
-        "precision20": float(np.mean([tm.precision_at(e) for e in errors[scored].T])),
-        "success_auc": float(np.mean([tm.success_auc(o) for o in overlaps[scored].T])),
+        "mean_cle": float(errors[filtered].mean()),
+        "precision20": float(np.mean([tm.precision_at(e) for e in tm.scored_frames(errors).T])),
+        "success_auc": float(np.mean([tm.success_auc(o) for o in tm.scored_frames(overlaps).T])),
         "ms_per_frame": 1000.0 * seconds / (sequence.n_frames - 1),
         "filter_s": seconds,  # the whole sequence, frame production excluded
         "fps": (sequence.n_frames - 1) / seconds,
@@ -172,7 +175,7 @@ def run(run: Run) -> dict:
         evaluation = {**run.model.get("evaluation", {}), **spec.get("evaluation", {})}
         record.update(multi_target_scores(evaluation, estimates, truth, sequence.visibility[:, chosen], chosen))
     for rule in tm.CORRECT_RULES:
-        correct = tm.correct_frames(errors[scored], overlaps[scored], rule)
+        correct = tm.correct_frames(errors[filtered], overlaps[filtered], rule)
         record[f"correct_frames[{rule}]"] = float(correct.mean())
         record[f"tracked_to_end[{rule}]"] = float(all(tm.tracked_to_end(c) for c in correct.T))
     if strip:
@@ -185,6 +188,7 @@ def run(run: Run) -> dict:
         "box": np.round(estimates, 2).tolist(),
         "targets": chosen,
         "ess": [None] + np.round(np.mean([o.ess for o in outputs], axis=0), 2).tolist(),
+        "seconds": [None] + np.round(tracker.frame_seconds, 7).tolist(),  # per filtered frame, all targets
     }
     if collectors["alpha"].value is not None:  # fusion_pf's alpha_k, first target
         record["per_frame"]["alpha"] = [None] + np.round(collectors["alpha"].value, 4).tolist()
