@@ -1,8 +1,9 @@
-"""``pf-replicate [run|report|scenes] key=value ...`` (or ``python -m replication``): the one entry point.
+"""``pf-replicate [run|report|scenes|export] key=value ...`` (or ``python -m replication``): the one entry point.
 
 ``run`` (the default) checks the request, runs what is missing and writes the experiment's report;
 ``report`` redraws reports from stored runs (:mod:`replication.report.__main__`); ``scenes`` writes
-an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`).
+an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`); ``export`` writes a
+tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod:`replication.export`).
 
 Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
@@ -35,6 +36,7 @@ SUBCOMMANDS = {
     "run": "replication.cli:run",
     "report": "replication.report.__main__:main",
     "scenes": "replication.scenes.__main__:main",
+    "export": "replication.export:main",
 }
 
 

@@ -16,7 +16,7 @@ import replication
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.claims import evaluate
-from replication.report.figures import draw
+from replication.report.figures import NothingToDraw, draw
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
 from replication.report.scale import scale_changes, scale_note
@@ -51,7 +51,10 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
                            "note": table.note})
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
-            draw(records, figure_spec, experiment, out / file)
+            try:
+                draw(records, figure_spec, experiment, out / file)
+            except NothingToDraw:  # as a table none of whose conditions ran: left out
+                continue
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
             beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link,

@@ -7,6 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from replication.report.figures import NothingToDraw
 from replication.report.ranking import rankings, unreliable
 from replication.report.style import OUTCOME_COLOURS, axis_label, save
 
@@ -19,7 +20,7 @@ def ranking(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> 
     right, the matrix of P(row beats column).  A ranking that is not reliable says why above it."""
     found = rankings(records, spec)
     if not found:
-        raise ValueError(f"figure {spec.get('name', 'ranking')!r}: no two methods ran on the same sequences")
+        raise NothingToDraw(f"figure {spec.get('name', 'ranking')!r}: no two methods ran on the same sequences")
     heights = [max(2.4, 0.42 * len(r.methods) + 1.4) for r in found.values()]
     fig, axes = plt.subplots(len(found), 2, figsize=(12, sum(heights)), squeeze=False,
                              gridspec_kw={"height_ratios": heights, "width_ratios": [1.1, 1]})
