@@ -205,3 +205,14 @@ def test_a_misspelt_sequence_of_ones_own_fails_in_one_line(tmp_path, args, named
     result, _ = request(tmp_path, "experiment=hspf", "scale=quick", *(
         [f"data.otb={girl.parent}"] if not any(a.startswith("data.otb") for a in args) else []), *args)
     assert_one_line(result, tmp_path, named)
+
+
+@pytest.mark.parametrize("scale", ["quick", "paper"])
+def test_every_shipped_experiment_passes_the_preflight(make_cfg, scale):
+    """The checks refuse nothing the project ships (their rules are about values, not about our configs)."""
+    from replication.paths import experiment_names
+    from replication.runner.preflight import check_yaml, preflight
+
+    for name in experiment_names():
+        check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
+        preflight(make_cfg(name, f"scale={scale}", "outside_project=true"))

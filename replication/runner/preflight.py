@@ -24,7 +24,7 @@ from omegaconf import DictConfig, ListConfig, OmegaConf
 from replication.errors import ConfigError
 from replication.paths import inside_project, project_dir, resolve
 
-SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*")
+SAFE_NAME = re.compile(r"(?![.\s])[^/\\\x00-\x1f]+")  # one file name: no separator, no leading dot
 SCALES = ("paper", "quick")
 POSITIVE = re.compile(r"(sigma\w*|\w+_sigma|\w*_var|variance|Q|R)")  # a scale: zero or less is meaningless
 NOT_NEGATIVE = re.compile(r"(\w+_sd|P0)")  # a standard deviation: zero switches the noise off
@@ -94,7 +94,7 @@ def check_experiment(cfg: DictConfig) -> None:
         raise ConfigError("name an experiment: experiment=<name>")
     name = experiment.get("name")
     if not isinstance(name, str) or not SAFE_NAME.fullmatch(name):
-        raise ConfigError(f"experiment.name must be letters, digits and _ . + - (a file name), got {name!r}")
+        raise ConfigError(f"experiment.name must be one file name (no / or \\, no leading dot), got {name!r}")
     if "multiverse" in experiment:
         return
     for block in ("model", "methods"):
@@ -106,7 +106,7 @@ def check_experiment(cfg: DictConfig) -> None:
     for block in NAMED_BLOCKS:
         for key, value in (experiment.get(block) or {}).items():
             if not SAFE_NAME.fullmatch(str(key)):
-                raise ConfigError(f"experiment.{block}: the name {key!r} must be letters, digits and _ . + -")
+                raise ConfigError(f"experiment.{block}: the name {key!r} must be one file name (no / or \\, no leading dot)")
             if not isinstance(value, DictConfig):
                 raise ConfigError(f"experiment.{block}.{key} must be a mapping, got {_kind(value)}")
     for key, method in experiment.methods.items():
