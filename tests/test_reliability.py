@@ -236,3 +236,25 @@ def test_every_shipped_experiment_passes_the_checks(make_cfg):
         runs, _, settings = prepare(make_cfg(experiment, *SMALL))
         assert runs and settings == ("loky", 2, None)
     assert prepare(make_cfg("hspf_ungm", *SMALL, "parallel.backend=threading"))[2] == ("threading", 2, None)
+
+
+def test_sigterm_stops_like_ctrl_c_and_leaves_no_worker(tmp_path):
+    """``kill <pid>`` (SIGTERM to the runner alone, as a batch system sends it): one line, status 130,
+    every stored run kept, and none of its worker processes left computing."""
+    args = ("scale=quick", "experiment.runs.quick=4", "experiment.model.sweep.steps=[10,25,50]", "n_jobs=2")
+    runs_dir = tmp_path / "store" / "ungm_horizon" / "runs"
+    process = subprocess.Popen(command("ungm_horizon", tmp_path / "store", tmp_path / "reports", *args),
+                               cwd=PROJECT_ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 60
+    while not list(runs_dir.glob("*.json")) and process.poll() is None and time.time() < deadline:
+        time.sleep(0.01)
+    children = [int(p) for p in Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text().split()]
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, (process.returncode, err)
+    match = INTERRUPTED.fullmatch(err.strip())
+    assert match and int(match[1]) == len(list(runs_dir.glob("*.json"))), err
+    time.sleep(2)
+    alive = [pid for pid in children if Path(f"/proc/{pid}").exists()
+             and "zombie" not in Path(f"/proc/{pid}/status").read_text().lower()]
+    assert not alive, f"worker processes still running after SIGTERM: {alive}"
