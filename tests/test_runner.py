@@ -333,3 +333,16 @@ def test_tab_completion_offers_experiments_and_keys():
 
     assert complete("pf-replicate experiment=hspf_u") == ["experiment=hspf_ungm", "experiment=hspf_ungm_sweep"]
     assert "scale=" in complete("pf-replicate experiment=hspf sc")
+
+
+def test_records_are_created_as_open_would_create_them(make_cfg, tmp_path):
+    """Group- and world-readable under the usual umask 022 (mkstemp alone gives 0600), private under 077."""
+    runs = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=1"))[:1]
+    for mask, mode in ((0o022, 0o644), (0o077, 0o600)):
+        store = Store(tmp_path / f"store{mask:o}", "hspf_ungm")
+        previous = os.umask(mask)
+        try:
+            store.write(runs[0], {"run_id": runs[0].run_id})
+        finally:
+            os.umask(previous)
+        assert store.path(runs[0]).stat().st_mode & 0o777 == mode

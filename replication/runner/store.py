@@ -63,6 +63,16 @@ CORRUPT_SUFFIX = ".corrupt"
 STALE_TEMPORARY_S = 3600  # a temporary file this old belongs to a writer that was killed
 
 
+FILE_MODE = 0o666  # as open() creates files: the umask decides who else may read records
+
+
+def current_umask() -> int:
+    """The process's umask (read by setting it, the only way POSIX offers, and putting it back)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 class Store:
     def __init__(self, root: str | Path, experiment: str):
         self.directory = Path(root) / experiment / "runs"
@@ -141,6 +151,7 @@ class Store:
         self.directory.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=".", suffix=".tmp")
         try:
+            os.fchmod(fd, FILE_MODE & ~current_umask())  # mkstemp's 0600 would hide a shared store
             with os.fdopen(fd, "w") as handle:
                 json.dump(record, handle, indent=1, sort_keys=True)
                 handle.flush()
