@@ -5,6 +5,7 @@ import os
 import re
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -198,6 +199,20 @@ def test_store_write_is_atomic(tmp_path, make_cfg):
     assert list(store.directory.iterdir()) == []  # no partial file, no stray temporary
     store.write(run, {"x": 1.0})
     assert json.loads(store.path(run).read_text()) == {"x": 1.0}
+
+
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o002, 0o664), (0o077, 0o600)])
+def test_stored_files_are_created_as_open_creates_them(tmp_path, make_cfg, umask, mode):
+    """Records and failures get 0o666 less the umask (readable by the group under the usual 022), not 0o600."""
+    first, second = expand(make_cfg("hspf_ungm", *SMALL))[:2]
+    store = Store(tmp_path, "hspf_ungm")
+    previous = os.umask(umask)
+    try:
+        store.write(first, {"x": 1.0})
+        store.write_failure(second, "not finite: rmse=nan")
+    finally:
+        os.umask(previous)
+    assert {stat.S_IMODE(p.stat().st_mode) for p in (store.path(first), store.failure_path(second))} == {mode}
 
 
 def test_interrupted_job_resumes_to_the_same_table(tmp_path):

@@ -32,7 +32,8 @@ def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.Data
     """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics.
 
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
-    yet stored are absent (run the experiment first).
+    yet stored are absent (run the experiment first), and so are runs that failed
+    (:mod:`replication.runner.failures`).
     """
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
