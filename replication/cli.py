@@ -8,8 +8,10 @@ tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod
 Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
 stderr and exit status 2 before anything heavy is imported or written; never a Hydra traceback.
-Ctrl-C (SIGINT) and SIGTERM stop the workers, keep every run already stored and exit with status
-130 and one line.
+Ctrl-C (SIGINT) and SIGTERM stop the workers, keep every run already stored and exit with one line
+and status 130 (143 after SIGTERM); no worker or companion outlives this process, however it ends.
+Runs whose numbers are not finite are recorded as failed, named with their count, and make the
+command exit with status 3.
 """
 
 import importlib
@@ -26,6 +28,9 @@ from omegaconf import DictConfig
 from replication import __version__
 from replication.errors import ConfigError, fail
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
+from replication.runner.lifeline import (
+    child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
+)
 from replication.runner.preflight import check_yaml, preflight
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
@@ -112,26 +117,21 @@ def check_request(argv: list[str]) -> None:
 
 
 def interrupted(store=None, runs=None) -> None:
-    """The one line of a Ctrl-C or SIGTERM, and exit status 130 (128 + SIGINT) as shells expect."""
+    """The one line of a Ctrl-C or SIGTERM, and exit status 128 + the signal (130, 143) as shells expect."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while we count must not print a traceback
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     if store is None or runs is None:
         print("interrupted: rerun the same command to resume", file=sys.stderr)
     else:
         stored = sum(store.path(run).exists() for run in runs)
         print(f"interrupted: {stored} runs stored, rerun the same command to resume", file=sys.stderr)
-    raise SystemExit(130)
-
-
-def terminate_as_interrupt(signum, frame) -> None:
-    """SIGTERM (``kill``, a batch system's time limit) goes the way of Ctrl-C: workers stopped, runs kept."""
-    raise KeyboardInterrupt
+    raise SystemExit(interrupt_status())
 
 
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
 def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
     from replication.runner.execute import BackendError, execute
+    from replication.runner.failures import exit_if_failed
     from replication.runner.store import Store
     from replication.runner.validate import prepare
 
@@ -154,6 +154,7 @@ def run_experiment(cfg: DictConfig) -> None:
         written = write_experiment_report(cfg, runs, store)
         print(f"{cfg.experiment.name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
         run_companions(cfg)
+        exit_if_failed(store, runs)
     except BackendError as error:
         fail(str(error))
     except KeyboardInterrupt:
@@ -197,11 +198,12 @@ def run_multiverse(cfg: DictConfig) -> None:
 def run_companions(cfg: DictConfig) -> None:
     """Run the experiments a paper's main one names in ``also:`` (e.g. hspf's UNGM half), with the same
     settings except those addressed to this experiment (``experiment.*``, its ``sequences=``)."""
-    own = ("experiment=", "experiment.", "+experiment.", "sequences=", "-")
+    own = ("experiment=", "experiment.", "+experiment.", "~experiment.", "sequences=", "-")
     shared = [a for a in sys.argv[1:] if not a.startswith(own)]
     for name in cfg.experiment.get("also", []) or []:
         print(f"{cfg.experiment.name}: also {name}")
-        status = subprocess.run([sys.executable, "-m", "replication", f"experiment={name}", *shared]).returncode
+        status = subprocess.run([sys.executable, "-m", "replication", f"experiment={name}", *shared],
+                                env=child_environment()).returncode
         if status:
             raise SystemExit(status)
 
@@ -229,7 +231,8 @@ def main(argv: list[str] | None = None) -> None:
     if QUIET_CHILDREN not in os.environ.get("PYTHONWARNINGS", ""):
         os.environ["PYTHONWARNINGS"] = ",".join(filter(None, [os.environ.get("PYTHONWARNINGS"), QUIET_CHILDREN]))
     os.environ[HOME_VARIABLE] = str(project_dir())  # workers and companions resolve paths as we do
-    signal.signal(signal.SIGTERM, terminate_as_interrupt)
+    stop_on_sigterm()
+    watch_parent_from_environment()  # a companion experiment ends with the runner that started it
     command, argv = (argv[0], argv[1:]) if argv and argv[0] in SUBCOMMANDS else ("run", argv)
     try:
         module, function = SUBCOMMANDS[command].split(":")

@@ -10,3 +10,8 @@ class ConfigError(ValueError):
 def fail(message: str) -> None:
     print(f"error: {message}", file=sys.stderr)
     raise SystemExit(2)
+
+
+class NotFinite(ValueError):
+    """A number a run needs is NaN or infinite (log-weights, say): the run fails with this reason, which
+    is stored (:mod:`replication.runner.failures`), rather than stopping the command."""

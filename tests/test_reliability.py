@@ -82,8 +82,51 @@ def test_corrupt_result_files_are_set_aside_and_rerun(make_cfg, tmp_path, capsys
     assert execute(runs, store, n_jobs=1, progress=False) == 0
 
 
-def test_sigint_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg, tmp_path):
-    """Ctrl-C at one random moment, SIGKILL at another, resume: the table of an uninterrupted run.
+def processes() -> dict[int, tuple[int, str]]:
+    """Every process on this machine: its parent's pid and its state (R, S, Z...), from /proc."""
+    table = {}
+    for entry in Path("/proc").iterdir():
+        try:
+            if entry.name.isdigit():
+                state, parent = (entry / "stat").read_text().rsplit(")", 1)[1].split()[:2]
+                table[int(entry.name)] = (int(parent), state)
+        except OSError:  # ended meanwhile
+            pass
+    return table
+
+
+def descendants(pid: int) -> set[int]:
+    """The processes ``pid`` started, and the ones they started, and so on."""
+    table, found, parents = processes(), set(), {pid}
+    while parents:
+        parents = {child for child, (parent, _) in table.items() if parent in parents} - found
+        found |= parents
+    return found
+
+
+def still_running(pids: set[int]) -> set[int]:
+    table = processes()
+    return {pid for pid in pids if pid in table and table[pid][1] != "Z"}
+
+
+def assert_all_end(pids: set[int], within: float = 5.0) -> None:
+    """Every one of ``pids`` ends within ``within`` seconds; any left are killed (not left to the suite)."""
+    deadline = time.time() + within
+    while still_running(pids) and time.time() < deadline:
+        time.sleep(0.1)
+    left = {pid: Path(f"/proc/{pid}/cmdline").read_bytes()[:120] for pid in still_running(pids)}
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, left
+
+
+NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table in /proc")
+
+
+@NEEDS_PROC
+def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg, tmp_path):
+    """Ctrl-C at one random moment, SIGTERM at another, SIGKILL at a third, resume: the table of an
+    uninterrupted run.  SIGTERM is handled as Ctrl-C, with status 143 (128 + 15), and leaves no process.
 
     A moment is "when the k-th run has landed, plus a random delay", k and the
     delay drawn from a seeded generator (RELIABILITY_SEED), so that on a fast or
@@ -101,38 +144,81 @@ def test_sigint_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg,
     def stored() -> int:
         return len(list(runs_dir.glob("*.json")))
 
-    def start_and_signal(sig: int, landed: int) -> subprocess.Popen:
-        """Start the command, wait until ``landed`` runs are stored and a random moment more, signal."""
+    def start_and_signal(sig: int, landed: int) -> tuple[subprocess.Popen, set[int]]:
+        """Start the command, wait until ``landed`` runs are stored and a random moment more, signal;
+        return the process and the processes it had started."""
         process = subprocess.Popen(cmd, cwd=PROJECT_ROOT, start_new_session=True, text=True,
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         deadline = time.time() + 50
         while stored() < landed and process.poll() is None and time.time() < deadline:
             time.sleep(0.005)
         time.sleep(rng.uniform(0.0, 0.1))
-        if process.poll() is None:
+        started = descendants(process.pid)
+        if process.poll() is None and sig == signal.SIGTERM:
+            os.kill(process.pid, sig)  # the runner alone, as kill <pid> does
+        elif process.poll() is None:
             os.killpg(process.pid, sig)  # the whole group, as a terminal's Ctrl-C does
-        return process
+        return process, started
 
-    process = start_and_signal(signal.SIGINT, landed=rng.randint(1, len(runs) // 3))
-    out, err = process.communicate(timeout=60)
-    assert process.returncode == 130, (process.returncode, err)
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    match = INTERRUPTED.fullmatch(err.strip())
-    assert match and int(match[1]) == stored(), err
-    after_sigint = stored()
+    def interrupted(sig: int, landed: int, status: int) -> int:
+        """Interrupt a run with ``sig``: it exits with ``status`` and one line counting the runs stored."""
+        process, started = start_and_signal(sig, landed)
+        _, err = process.communicate(timeout=60)
+        assert process.returncode == status, (process.returncode, err)
+        assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+        match = INTERRUPTED.fullmatch(err.strip())
+        assert match and int(match[1]) == stored(), err
+        assert_all_end(started)
+        return stored()
+
+    after_sigint = interrupted(signal.SIGINT, rng.randint(1, len(runs) // 4), status=130)
     assert 1 <= after_sigint < len(runs)
+    after_sigterm = interrupted(signal.SIGTERM, rng.randint(after_sigint + 1, max(after_sigint + 1, len(runs) // 2)),
+                                status=143)
+    assert after_sigint < after_sigterm < len(runs), (after_sigint, after_sigterm, len(runs))
 
-    landed = rng.randint(after_sigint + 1, max(after_sigint + 1, 2 * len(runs) // 3))
-    process = start_and_signal(signal.SIGKILL, landed=landed)
+    landed = rng.randint(after_sigterm + 1, max(after_sigterm + 1, 3 * len(runs) // 4))
+    process, _ = start_and_signal(signal.SIGKILL, landed=landed)
     process.communicate(timeout=60)
     assert process.returncode == -signal.SIGKILL
     after_sigkill = stored()
-    assert after_sigint < after_sigkill < len(runs), (after_sigint, after_sigkill, len(runs))
+    assert after_sigterm < after_sigkill < len(runs), (after_sigterm, after_sigkill, len(runs))
 
     resumed = subprocess.run(cmd, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{len(runs) - after_sigkill} runs computed, {after_sigkill} already stored" in resumed.stdout
     pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
+
+
+@NEEDS_PROC
+@pytest.mark.parametrize(
+    "experiment, args",
+    [
+        # its own workers, busy: two short runs, then two long ones (minutes, were they not stopped)
+        ("ungm_horizon", ("experiment.runs.quick=2", "~experiment.methods.grid",
+                          "experiment.methods.PF.sweep.n_particles=[100]", "experiment.model.sweep.steps=[10,1000000]")),
+        # its companion (also:), and the companion's workers
+        ("hspf_ungm", ("experiment.runs.quick=1", "experiment.report={}", "+experiment.also=[ungm_horizon]")),
+    ],
+    ids=["workers", "companion"],
+)
+def test_no_worker_or_companion_outlives_a_killed_runner(tmp_path, experiment, args):
+    """``kill -9`` of the runner once a run of ungm_horizon is stored: within seconds, every process it
+    started (loky workers and resource trackers, a companion experiment and the companion's) has ended."""
+    store, watched = tmp_path / "store", "ungm_horizon"
+    with open(tmp_path / "output", "w") as output:  # not a pipe: orphans holding it would block the reader
+        process = subprocess.Popen(command(experiment, store, tmp_path / "reports", "scale=quick", "n_jobs=2", *args),
+                                   cwd=PROJECT_ROOT, stdout=output, stderr=subprocess.STDOUT)
+    started, deadline = set(), time.time() + 120
+    while not any((store / watched / "runs").glob("*.json")) and process.poll() is None and time.time() < deadline:
+        started |= descendants(process.pid)
+        time.sleep(0.02)
+    started |= descendants(process.pid)
+    assert process.poll() is None, (tmp_path / "output").read_text()
+    assert len(started) >= 4, started  # two workers and two resource trackers at least
+    process.kill()
+    process.wait()
+    assert_all_end(started)
 
 
 @pytest.mark.parametrize("backend", ["loky", "dask"])
@@ -237,24 +323,3 @@ def test_every_shipped_experiment_passes_the_checks(make_cfg):
         assert runs and settings == ("loky", 2, None)
     assert prepare(make_cfg("hspf_ungm", *SMALL, "parallel.backend=threading"))[2] == ("threading", 2, None)
 
-
-def test_sigterm_stops_like_ctrl_c_and_leaves_no_worker(tmp_path):
-    """``kill <pid>`` (SIGTERM to the runner alone, as a batch system sends it): one line, status 130,
-    every stored run kept, and none of its worker processes left computing."""
-    args = ("scale=quick", "experiment.runs.quick=4", "experiment.model.sweep.steps=[10,25,50]", "n_jobs=2")
-    runs_dir = tmp_path / "store" / "ungm_horizon" / "runs"
-    process = subprocess.Popen(command("ungm_horizon", tmp_path / "store", tmp_path / "reports", *args),
-                               cwd=PROJECT_ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    deadline = time.time() + 60
-    while not list(runs_dir.glob("*.json")) and process.poll() is None and time.time() < deadline:
-        time.sleep(0.01)
-    children = [int(p) for p in Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text().split()]
-    process.send_signal(signal.SIGTERM)
-    _, err = process.communicate(timeout=60)
-    assert process.returncode == 130, (process.returncode, err)
-    match = INTERRUPTED.fullmatch(err.strip())
-    assert match and int(match[1]) == len(list(runs_dir.glob("*.json"))), err
-    time.sleep(2)
-    alive = [pid for pid in children if Path(f"/proc/{pid}").exists()
-             and "zombie" not in Path(f"/proc/{pid}/status").read_text().lower()]
-    assert not alive, f"worker processes still running after SIGTERM: {alive}"

@@ -5,6 +5,7 @@ import os
 import re
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -214,6 +215,20 @@ def test_store_write_is_atomic(tmp_path, make_cfg):
     assert json.loads(store.path(run).read_text()) == {"x": 1.0}
 
 
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o002, 0o664), (0o077, 0o600)])
+def test_stored_files_are_created_as_open_creates_them(tmp_path, make_cfg, umask, mode):
+    """Records and failures get 0o666 less the umask (readable by the group under the usual 022), not 0o600."""
+    first, second = expand(make_cfg("hspf_ungm", *SMALL))[:2]
+    store = Store(tmp_path, "hspf_ungm")
+    previous = os.umask(umask)
+    try:
+        store.write(first, {"x": 1.0})
+        store.write_failure(second, "not finite: rmse=nan")
+    finally:
+        os.umask(previous)
+    assert {stat.S_IMODE(p.stat().st_mode) for p in (store.path(first), store.failure_path(second))} == {mode}
+
+
 def test_interrupted_job_resumes_to_the_same_table(tmp_path):
     """Kill a real run part-way (SIGKILL: no clean-up), resume it, compare with an uninterrupted run."""
     args = ["experiment=ungm_horizon", "scale=quick", "experiment.runs.quick=6", "n_jobs=2", "progress=false"]
@@ -334,15 +349,3 @@ def test_tab_completion_offers_experiments_and_keys():
     assert complete("pf-replicate experiment=hspf_u") == ["experiment=hspf_ungm", "experiment=hspf_ungm_sweep"]
     assert "scale=" in complete("pf-replicate experiment=hspf sc")
 
-
-def test_records_are_created_as_open_would_create_them(make_cfg, tmp_path):
-    """Group- and world-readable under the usual umask 022 (mkstemp alone gives 0600), private under 077."""
-    runs = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=1"))[:1]
-    for mask, mode in ((0o022, 0o644), (0o077, 0o600)):
-        store = Store(tmp_path / f"store{mask:o}", "hspf_ungm")
-        previous = os.umask(mask)
-        try:
-            store.write(runs[0], {"run_id": runs[0].run_id})
-        finally:
-            os.umask(previous)
-        assert store.path(runs[0]).stat().st_mode & 0o777 == mode

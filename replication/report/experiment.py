@@ -33,7 +33,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     experiment = experiment_at_scale(cfg)
     out = resolve(cfg.reports) / experiment["name"]
     out.mkdir(parents=True, exist_ok=True)
-    records = store.load(runs)
+    records, failures = store.load(runs), store.failures(runs)  # failed runs: counted, in no statistic
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
     tables, figures, built, files, results = [], [], {}, [], []
@@ -85,6 +85,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             scale=cfg.scale,
             n_records=len(records),
             n_runs=len(runs),
+            failures=failures.most_common(),
+            n_failed=failures.total(),
             tables=tables,
             files=files,
             scenes=_scenes(experiment),
@@ -111,6 +113,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         "scale": cfg.scale,
         "n_records": len(records),
         "n_runs": len(runs),
+        "failed": dict(failures),
         "verdicts": dict(verdicts),
         "cells": compared,
         "claims": claims,

@@ -15,6 +15,7 @@ same relative path.
 
 import importlib.util
 import logging
+import os
 import signal
 import sys
 import threading
@@ -27,7 +28,10 @@ from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
 import replication
+from replication.errors import NotFinite
 from replication.run import Run
+from replication.runner.failures import failure
+from replication.runner.lifeline import watch_parent
 from replication.runner.memory import retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
@@ -48,10 +52,17 @@ class BackendError(RuntimeError):
 
 
 def perform(run: Run) -> dict:
-    """One run: a pure function of the run's identity, parameters and seed."""
+    """One run: a pure function of the run's identity, parameters and seed.  Its record, or, when a
+    number it needs or gives is not finite, only its run id and the reason (``failure``, :mod:`.failures`)."""
     retain_freed_memory()  # in whichever process computes it: a worker of any backend
     started = time.perf_counter()
-    metrics = TASKS[run.task].run(run)
+    try:
+        metrics = TASKS[run.task].run(run)
+        reason = failure(metrics)
+    except NotFinite as error:
+        reason = str(error)
+    if reason:
+        return {"run_id": run.run_id, "failure": reason}
     return {
         **run.identity(),
         **metrics,
@@ -109,17 +120,19 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
             if started:
                 ray.shutdown()
     elif backend == "loky":
-        with parallel_config(backend="loky", n_jobs=n_jobs, initializer=leave_interrupts_to_parent):
+        with parallel_config(backend="loky", n_jobs=n_jobs, initializer=start_worker, initargs=(os.getpid(),)):
             yield
     else:
         with parallel_config(backend=backend, n_jobs=n_jobs):
             yield
 
 
-def leave_interrupts_to_parent() -> None:
-    """A loky worker ignores SIGINT: a terminal's Ctrl-C reaches the whole process group, and a
-    worker caught waiting for its next run would print a traceback; the parent stops the workers."""
+def start_worker(runner: int) -> None:
+    """A loky worker's initializer.  It ignores SIGINT: a terminal's Ctrl-C reaches the whole process
+    group, and a worker caught waiting for its next run would print a traceback; the parent stops the
+    workers.  And it exits as soon as ``runner`` (the process that started it) is gone."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    watch_parent(runner)
 
 
 @contextmanager
@@ -202,11 +215,11 @@ def execute(
     progress: bool = True,
     address: str | None = None,
 ) -> int:
-    """Run every run not yet stored; return how many were run.
+    """Run every run neither stored nor failed; return how many were run.
 
-    Records are written by this process as each run finishes (in any order),
-    so an interrupted job loses only the runs in flight, and a rerun of the
-    same command skips everything already stored.  Corrupt result files are
+    Records (or the failures of runs with numbers that are not finite) are written by this process as
+    each run finishes (in any order), so an interrupted job loses only the runs in flight, and a rerun
+    of the same command skips everything already stored or failed.  Corrupt result files are
     named in one line on stderr, set aside and run again (see :mod:`.store`).
     A KeyboardInterrupt stops the workers and propagates, with every record
     that arrived before it stored.
@@ -229,6 +242,10 @@ def execute(
         _records(pending, streamed=backend not in LIST_ONLY_BACKENDS)
     ) as records:
         for record in records:
-            store.write(by_id[record["run_id"]], record)
+            run = by_id[record["run_id"]]
+            if "failure" in record:
+                store.write_failure(run, record["failure"])
+            else:
+                store.write(run, record)
             bar.update()
     return len(pending)

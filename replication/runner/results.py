@@ -90,7 +90,8 @@ def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.Data
     """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics.
 
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
-    yet stored are absent (run the experiment first).
+    yet stored are absent (run the experiment first), and so are runs that failed
+    (:mod:`replication.runner.failures`).
     """
     return tidy(*stored_records(experiment, scale, *overrides))
 

@@ -1,6 +1,7 @@
 """The result store: one JSON record per finished run, written atomically.
 
-Layout: ``<root>/<experiment>/runs/<method>__<condition>__<key>__r<rep>.json``.
+Layout: ``<root>/<experiment>/runs/<method>__<condition>__<key>__r<rep>.json``, or, for a run that
+failed (:mod:`replication.runner.failures`), ``...__r<rep>.failed`` holding the reason.
 The key hashes everything that can change a run's numbers (task, model and
 method parameters, base seed, and the digest of the code that computes runs,
 :func:`replication.runner.provenance.code_digest`), so a changed config lands in
@@ -19,9 +20,10 @@ killed mid-write (``.<random>.tmp``) are never read, and are deleted once an
 hour old.
 
 Several processes or machines on one store (a shared or network file
-system): every run is its own file, written to a unique temporary file in the
-same folder (``mkstemp``: no two writers share one) and then renamed over its
-final name (``os.replace``, atomic on local POSIX file systems and on NFS).  So
+system): every run is its own file, written to a new temporary file in the
+same folder (a random name, created exclusively: no two writers share one) and
+then renamed over its final name (``os.replace``, atomic on local POSIX file
+systems and on NFS), readable by the group under the usual umask.  So
 
 * no run is lost: writers never touch each other's files, and no file is
   ever rewritten in place, so a reader sees a whole record or none;
@@ -46,10 +48,13 @@ once more, to the same numbers.
 
 import json
 import os
+import secrets
 import sys
-import tempfile
 import time
+from collections import Counter
+from collections.abc import Callable
 from pathlib import Path
+from typing import TextIO
 
 import pandas as pd
 
@@ -63,22 +68,15 @@ CORRUPT_SUFFIX = ".corrupt"
 STALE_TEMPORARY_S = 3600  # a temporary file this old belongs to a writer that was killed
 
 
-FILE_MODE = 0o666  # as open() creates files: the umask decides who else may read records
-
-
-def current_umask() -> int:
-    """The process's umask (read by setting it, the only way POSIX offers, and putting it back)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 class Store:
     def __init__(self, root: str | Path, experiment: str):
         self.directory = Path(root) / experiment / "runs"
 
     def path(self, run: Run) -> Path:
         return self.directory / f"{_safe(run.run_id)}.json"
+
+    def failure_path(self, run: Run) -> Path:
+        return self.directory / f"{_safe(run.run_id)}.failed"
 
     def has(self, run: Run) -> bool:
         """Whether a sound record of ``run`` is stored (see :meth:`read`)."""
@@ -116,7 +114,7 @@ class Store:
         return record
 
     def pending(self, runs: list[Run]) -> tuple[list[Run], list[str]]:
-        """The runs without a sound record, and one note per corrupt file set aside on the way.
+        """The runs neither stored soundly nor failed, and one note per corrupt file set aside on the way.
 
         A corrupt file is renamed to ``<name>.json.corrupt`` so that its run is
         computed again and the damaged bytes stay for inspection.
@@ -125,7 +123,7 @@ class Store:
         pending, notes = [], []
         for run in runs:
             try:
-                if self.read(run) is not None:
+                if self.read(run) is not None or self.failure_path(run).exists():
                     continue
             except CorruptRecord as corrupt:
                 notes.append(str(corrupt))
@@ -148,17 +146,34 @@ class Store:
 
     def write(self, run: Run, record: dict) -> None:
         """Write ``record`` so that a crash leaves either the whole file or none of it."""
+        self._write(self.path(run), lambda handle: json.dump(record, handle, indent=1, sort_keys=True))
+
+    def write_failure(self, run: Run, reason: str) -> None:
+        """Record that ``run`` failed, and why (see :mod:`replication.runner.failures`)."""
+        self._write(self.failure_path(run), lambda handle: handle.write(reason + "\n"))
+
+    def failures(self, runs: list[Run]) -> Counter[str]:
+        """How many of ``runs`` failed, per reason; a run with a record as well counts as stored."""
+        return Counter(
+            self.failure_path(run).read_text().strip()
+            for run in runs
+            if self.failure_path(run).exists() and not self.path(run).exists()
+        )
+
+    def _write(self, path: Path, fill: Callable[[TextIO], object]) -> None:
+        """Write a new temporary file in the same folder with ``fill(handle)``, then rename it to ``path``.
+        The file gets the mode ``open()`` gives (0o666 less the umask: readable by the group and others
+        under the usual umask 022), so that a store can be shared."""
         self.directory.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=".", suffix=".tmp")
+        tmp = self.directory / f".{secrets.token_hex(8)}.tmp"
         try:
-            os.fchmod(fd, FILE_MODE & ~current_umask())  # mkstemp's 0600 would hide a shared store
-            with os.fdopen(fd, "w") as handle:
-                json.dump(record, handle, indent=1, sort_keys=True)
+            with open(tmp, "x") as handle:  # "x": created here, never an existing file
+                fill(handle)
                 handle.flush()
                 os.fsync(handle.fileno())
-            os.replace(tmp, self.path(run))
+            os.replace(tmp, path)
         except BaseException:
-            Path(tmp).unlink(missing_ok=True)
+            tmp.unlink(missing_ok=True)
             raise
 
     def load(self, runs: list[Run]) -> pd.DataFrame:

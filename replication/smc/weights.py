@@ -2,6 +2,8 @@
 
 import numpy as np
 
+from replication.errors import NotFinite
+
 
 class DegenerateWeightsError(ValueError):
     """Every log-weight is -inf: the weights cannot be normalised."""
@@ -20,12 +22,13 @@ def normalise(log_weights: np.ndarray) -> tuple[np.ndarray, float]:
     Works in the log domain throughout, so weights that would all underflow
     as raw products of likelihoods are still normalised correctly.  Raises
     :class:`DegenerateWeightsError` when every log-weight is -inf and
-    ``ValueError`` on NaN or +inf (a bug in the model, never data).
+    :class:`~replication.errors.NotFinite` on NaN or +inf (a model's parameters
+    out of range, or a bug in it; never data).
     """
     log_weights = np.asarray(log_weights, dtype=float)
     top = log_weights.max()
     if np.isnan(top) or top == np.inf:
-        raise ValueError("log-weights contain NaN or +inf")
+        raise NotFinite("log-weights contain NaN or +inf")
     if top == -np.inf:
         raise DegenerateWeightsError("every log-weight is -inf")
     weights = np.exp(log_weights - top)

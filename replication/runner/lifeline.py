@@ -1,0 +1,66 @@
+"""How the runner's processes end: no worker or companion outlives it, and SIGTERM stops it as Ctrl-C does.
+
+A child process holds a *lifeline* (:func:`watch_parent`): a daemon thread that ends the process
+(``os._exit``) within :data:`POLL_S` of its parent's death, however the parent died (``kill -9``
+included) and whether the child is computing or waiting.  The loky workers get it through their
+initializer (:func:`replication.runner.execute.parallel_backend`), and their resource trackers exit
+once no worker holds their pipe; a companion experiment (``also:``) gets it from the environment
+its runner starts it with (:func:`child_environment`, :func:`watch_parent_from_environment`).  The
+dask backend's local workers die with their parent already (distributed watches it); ray's
+processes are ray's to manage.
+"""
+
+import os
+import signal
+import threading
+import time
+from functools import cache
+
+PARENT_VARIABLE = "REPLICATION_PARENT_PID"  # set by a runner for the companion it starts
+POLL_S = 0.5
+_signal_received = signal.SIGINT  # the signal that interrupted this process, once one has
+
+
+@cache  # one watch per process and parent, however often it is asked for
+def watch_parent(parent: int) -> None:
+    """Exit this process as soon as its parent is no longer process ``parent`` (it died, and this
+    process was handed to another), checking every :data:`POLL_S` seconds from a daemon thread."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(POLL_S)
+        os._exit(1)  # no clean-up: the parent that would read the results is gone
+
+    threading.Thread(target=watch, name="lifeline", daemon=True).start()
+
+
+def child_environment() -> dict[str, str]:
+    """This process's environment, naming it as the parent a child started with it must not outlive."""
+    return {**os.environ, PARENT_VARIABLE: str(os.getpid())}
+
+
+def watch_parent_from_environment() -> None:
+    """In a process started with :func:`child_environment`: the lifeline to that parent (even if it died
+    before this process got here).  No-op otherwise."""
+    parent = os.environ.pop(PARENT_VARIABLE, None)  # not inherited further: a child of ours names us
+    if parent:
+        watch_parent(int(parent))
+
+
+def stop_on_sigterm() -> None:
+    """Handle SIGTERM as Ctrl-C: a KeyboardInterrupt in the main thread (workers stopped, stored runs
+    kept); a second SIGTERM ends the process at once."""
+    signal.signal(signal.SIGTERM, _interrupt)
+
+
+def _interrupt(signum: int, frame) -> None:
+    global _signal_received
+    _signal_received = signum
+    signal.signal(signum, signal.SIG_DFL)
+    raise KeyboardInterrupt
+
+
+def interrupt_status() -> int:
+    """The exit status of an interrupted command, 128 + the signal, as a shell reports a process that
+    signal killed: 130 after Ctrl-C (SIGINT), 143 after SIGTERM."""
+    return 128 + _signal_received
