@@ -149,7 +149,7 @@ def test_the_timeline_draws_a_lane_per_person_and_the_runs_switches(pets, drawn,
 def test_a_figure_link_is_on_the_page():
     figures = [{"name": "video", "title": "SORT on PETS", "file": "video.png", "link": "video.gif"},
                {"name": "plain", "title": "A plot", "file": "plain.png"}]
-    page = render("experiment.html.j2", title="t", paper="p", scale="smoke", n_records=1, n_runs=1,
+    page = render("experiment.html.j2", title="t", paper="p", scale="smoke", n_records=1, n_runs=1, n_failed=0, failures=[],
                   figures=figures, tables=[], scenes=[], claims=[], sweeps=[])
     assert '<a href="video.gif"><img src="video.png"' in page
     assert '<img src="plain.png"' in page and page.count("<a href=\"video.gif\">") == 2
