@@ -22,11 +22,11 @@ from omegaconf import DictConfig, OmegaConf
 from replication.errors import ConfigError
 from replication.filters import FILTERS, build_filter
 from replication.run import Run
+from replication.runner.preflight import SCALES
 from replication.runner.provenance import code_digest
 from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
 
-SCALES = ("paper", "quick")
 SHORT_NAMES = {"n_particles": "N", "steps": "T", "n_joint": "K"}
 
 
