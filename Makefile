@@ -4,6 +4,7 @@
 # make benchmark   time the SMC core on this machine (reports/benchmark/)
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
+# make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while replication/evidence/ is unchanged)
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -20,7 +21,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-all replicate readings report benchmark docs
+.PHONY: setup browser test test-all replicate readings report benchmark docs calibrate
 
 setup: $(VENV)/.installed
 
@@ -52,6 +53,7 @@ test-all: setup browser
 replicate: setup
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
 	$(BIN)/python benchmarks/benchmark.py
+	$(BIN)/python -m replication.report.calibration
 	$(BIN)/python -m replication.report.pdf
 
 readings: setup
@@ -63,6 +65,9 @@ benchmark: setup
 
 report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)
+
+calibrate: setup
+	$(BIN)/python -m replication.report.calibration
 
 docs: setup
 	$(BIN)/python -m pdoc -o reports/api replication

@@ -6,11 +6,11 @@ import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from replication.evidence.statistics import Estimate
+from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
 from replication.report.claims import Check, ClaimTest, Result, load_papers
 from replication.report.published import load_published
-from replication.report.statistics import Estimate
-from replication.report.verdict import Outcome, Verdict
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 PAPERS = load_papers()
@@ -68,7 +68,8 @@ def test_order_uses_paired_differences():
     assert _verdict({"test": "order", "metric": "rmse", "order": ["A", "B", "C"]}, records).outcome \
         is Outcome.REPRODUCED
     backwards = _verdict({"test": "order", "metric": "rmse", "order": ["C", "A"]}, records)
-    assert backwards == Verdict(Outcome.NOT_REPRODUCED, backwards.why) and "C - A at N=1" in backwards.why
+    assert backwards.outcome is Outcome.NOT_REPRODUCED and "C - A at N=1" in backwards.why
+    assert "the other way round" in backwards.why and backwards.p_against < 0.05
     tied = _records({"A": 0.0, "B": 0.0})
     assert _verdict({"test": "order", "metric": "rmse", "order": ["A", "B"]}, tied).outcome is Outcome.INCONCLUSIVE
     # "no slower than by more than 10 %": B is 4 % worse than A
@@ -82,11 +83,52 @@ def test_order_uses_paired_differences():
         Verdict(Outcome.NOT_TESTABLE, "too few runs (4)")
 
 
-def test_identical_outcomes_are_no_difference_not_a_win():
+def test_inconclusive_says_what_the_runs_could_detect():
+    tied = _records({"A": 0.0, "B": 0.0}, runs=5)
+    verdict = _verdict({"test": "order", "metric": "rmse", "order": ["A", "B"]}, tied)
+    assert verdict.outcome is Outcome.INCONCLUSIVE and "5 runs detect" in verdict.why
+
+
+def test_holm_keeps_nine_checks_from_calling_a_claim_wrong_on_one_unlucky_check():
+    # nine pairs, one of them a little the other way round (t = 2.68, p = 0.007 alone): not past Holm
+    z = np.random.default_rng(5).standard_normal(20)
+    z = (z - z.mean()) / z.std(ddof=1)  # mean 0, sd 1 exactly
+    rows = []
+    for condition in range(9):
+        for r in range(20):
+            shift = (0.06 if condition == 0 else 0.0) + 0.1 * z[r]
+            rows += [{"method": "A", "condition": f"N={condition}", "data_condition": "", "repetition": r,
+                      "rmse": 5.0 + shift}, {"method": "B", "condition": f"N={condition}", "data_condition": "",
+                                            "repetition": r, "rmse": 5.0}]
+    records = pd.DataFrame(rows)
+    checks = ClaimTest.of({"test": "order", "metric": "rmse", "order": ["A", "B"]}, EXPERIMENT).checks(records, {})
+    first = checks[0].verdict
+    assert first.outcome is Outcome.NOT_REPRODUCED and 9 * first.p_against > 0.05
+    result = Result.of(checks)
+    assert result.verdict.outcome is not Outcome.NOT_REPRODUCED
+    assert "not significant after Holm across 9 checks" in result.checks[0].verdict.why
+
+
+def test_identical_outcomes_decide_nothing_unless_the_paper_quotes_a_size():
     both_fail = _records({"A": 0.0, "B": 0.0}, metric="tracked_to_end[cle<=20]", noise=0.0)
     both_fail["tracked_to_end[cle<=20]"] = 0.0
     verdict = _verdict({"test": "order", "metric": "tracked_to_end[cle<=20]", "order": ["A", "B"]}, both_fail)
-    assert verdict.outcome is Outcome.NOT_REPRODUCED and "no difference" in verdict.why
+    assert verdict.outcome is Outcome.NOT_TESTABLE and "every run gives the same difference" in verdict.why
+
+
+def test_a_quoted_size_is_tested_against_ours():
+    published = pd.DataFrame({"paper": "p", "table": "1", "experiment": "", "method": ["A", "B"],
+                              "metric": "rmse", "condition": "N=1", "value": ["1.6", "4.2"], "unit": "",
+                              "note": "", "number": [1.6, 4.2]})
+    experiment = {"paper": "p", "methods": EXPERIMENT["methods"],
+                  "report": {"tables": [{"name": "t1", "paper_table": "1", "metric": "rmse"}]}}
+    records = _records({"A": 0.0, "B": 0.2})  # A better by 0.2, the paper's A better by 2.6
+    spec = {"test": "order", "metric": "rmse", "order": ["A", "B"], "size": {"table": "t1"}}
+    verdict = Result.of(ClaimTest.of(spec, experiment, published).checks(records, {})).verdict
+    assert verdict.outcome is Outcome.NOT_REPRODUCED and "the sign agrees, the size does not" in verdict.why
+    ratio = {**spec, "size": {"table": "t1", "kind": "ratio"}}
+    verdict = Result.of(ClaimTest.of(ratio, experiment, published).checks(records, {})).verdict
+    assert "ratio 0.381" in verdict.why
 
 
 def test_threshold():
@@ -95,6 +137,11 @@ def test_threshold():
                      "statistic": "median"}, records).outcome is Outcome.REPRODUCED
     assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 50.0},
                     records).outcome is Outcome.NOT_REPRODUCED
+    # 5 runs all above the bound: the exact sign test's floor, 1/32, decides (no order-statistic 95% interval)
+    five = _records({"A": 20.0}, runs=5, metric="fps")
+    verdict = _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 5.52,
+                        "statistic": "median"}, five)
+    assert verdict.outcome is Outcome.REPRODUCED and verdict.p_for == pytest.approx(1 / 32)
 
 
 def test_result_combines_checks():
@@ -102,7 +149,7 @@ def test_result_combines_checks():
         return Check("x", Verdict(outcome), Estimate(1.0, 0.5, 1.5, 10, ""))
 
     yes, no, maybe, untestable = (check(o) for o in (Outcome.REPRODUCED, Outcome.NOT_REPRODUCED,
-                                                     Outcome.INCONCLUSIVE, Outcome.NOT_TESTABLE))
+                                                     Outcome.INCONCLUSIVE, Outcome.NOT_TESTABLE))  # no p-values
     assert Result.of([yes, yes, untestable]).verdict.outcome is Outcome.REPRODUCED
     assert Result.of([yes, maybe]).verdict.outcome is Outcome.INCONCLUSIVE
     assert Result.of([maybe, no, yes]).verdict.outcome is Outcome.NOT_REPRODUCED

@@ -1,15 +1,16 @@
 """A paper's multiverse: designs over its open choices, overrides that only touch what exists, the
 default universe equal to the experiments as they stand, and each claim's robustness across cases."""
 
+import numpy as np
 import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
 from replication.errors import ConfigError
+from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
 from replication.report.claims import Claim, Reading, load_papers
 from replication.report.multiverse import READING, Case, Robustness, write_multiverse_report
-from replication.report.verdict import Outcome, Verdict
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
@@ -109,36 +110,56 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
     assert (page.parent / "readings.png").exists() and (page.parent / "cases.csv").exists()
 
 
-def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", held: int = 1) -> Case:
-    checks = tuple({"verdict": {"outcome": Outcome.REPRODUCED.value if i < held else outcome.value}}
+def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", held: int = 1,
+          per_run: dict | None = None) -> Case:
+    checks = tuple({"what": "A - B" if i == 0 else "other",
+                    "verdict": {"outcome": Outcome.REPRODUCED.value if i < held else outcome.value},
+                    "per_run": {str(k): v for k, v in (per_run or {}).items()} if i == 0 else {}}
                    for i in range(2))
     return Case(universe, (*picks.items(), (READING, reading)), Verdict(outcome),
                 {"what": "A - B", "number": universe, "value": 1.0}, checks)
 
 
 CLAIM = Claim("p.c", "p", "A beats B", "Table 1", {}, (Reading("r1", "e", {}),))
+RUNS = dict(enumerate(np.random.default_rng(4).normal(0.3, 1.0, 10)))
+
+
+def _shifted(by: float, noise: float = 0.05) -> dict:
+    rng = np.random.default_rng(int(by * 100) + 1)
+    return {r: v + by + noise * rng.standard_normal() for r, v in RUNS.items()}
 
 
 def test_robust_when_every_testable_case_agrees():
     cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED), _case("x=b", {"x": "b"}, Outcome.NOT_REPRODUCED),
              _case("x=c", {"x": "c"}, Outcome.NOT_TESTABLE))
     robustness = Robustness(CLAIM, cases)
-    assert robustness.robust is True and robustness.flips == []
-    assert robustness.summary == "robust: not reproduced in all 2 cases"
+    assert robustness.robust is True and robustness.flipped_by == []
+    assert robustness.summary.startswith("robust: no open choice moves the verdict")
 
 
-def test_a_flip_names_the_alternative_and_the_best_case_for_the_paper():
-    cases = (_case("default", {"x": "a", "y": "a"}, Outcome.NOT_REPRODUCED),
-             _case("x=b", {"x": "b", "y": "a"}, Outcome.REPRODUCED),
-             _case("y=b", {"x": "a", "y": "b"}, Outcome.INCONCLUSIVE, held=0),
+def test_a_verdict_that_reads_differently_with_no_effect_behind_it_is_noise():
+    # x=b's runs are the default's (common random numbers) plus a little noise: its different verdict from
+    # a few runs is no effect of the choice
+    cases = (_case("default", {"x": "a"}, Outcome.INCONCLUSIVE, per_run=RUNS),
+             _case("x=b", {"x": "b"}, Outcome.REPRODUCED, per_run=_shifted(0.0)))
+    robustness = Robustness(CLAIM, cases)
+    (effect,) = robustness.effects
+    assert effect.flips == 1 and not effect.significant and not effect.moves
+    assert robustness.robust is True and "largest effect on A - B: x=b" in robustness.summary
+
+
+def test_a_choice_with_a_real_effect_that_moves_the_verdict_makes_it_depend_on_the_reading():
+    cases = (_case("default", {"x": "a", "y": "a"}, Outcome.NOT_REPRODUCED, per_run=RUNS),
+             _case("x=b", {"x": "b", "y": "a"}, Outcome.REPRODUCED, per_run=_shifted(1.0)),
+             _case("y=b", {"x": "a", "y": "b"}, Outcome.INCONCLUSIVE, held=0, per_run=_shifted(0.0)),
              _case("y=b'", {"x": "a", "y": "b"}, Outcome.INCONCLUSIVE, reading="r2", held=1))
     robustness = Robustness(CLAIM, cases)
     assert robustness.robust is False
-    # each case against its twin (the same case with that choice at its default): r2 changes nothing
-    # against y=b scored by r1, so only x and y flip it
-    assert robustness.flips == [("x", "b", 1, 1), ("y", "b", 1, 1)]
+    moving = robustness.moving
+    assert [(e.choice, e.alternative) for e in moving] == [("x", "b")]
+    assert moving[0].effect.value == pytest.approx(1.0, abs=0.05) and moving[0].significant
     assert robustness.best_case.universe == "x=b"
-    assert "flipped under x=b (1 of 1)" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
+    assert "moved by x=b (+1" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
     # between two inconclusive cases the one with more checks holding is closer
     assert Robustness(CLAIM, cases[2:]).best_case.universe == "y=b'"
 
@@ -160,7 +181,8 @@ def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiv
     from replication.report.scorecard import claim_rows, claims_frame
 
     papers = [p for p in load_papers() if p.key == "hspf"]
-    cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED), _case("x=b", {"x": "b"}, Outcome.REPRODUCED))
+    cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED, per_run=RUNS),
+             _case("x=b", {"x": "b"}, Outcome.REPRODUCED, per_run=_shifted(1.0)))
     stored = Robustness(papers[0].claims[0], cases).as_dict()
     rows = claim_rows(papers, {"hspf_readings": {"multiverse": {papers[0].claims[0].id: stored}}})
     first, second = rows["hspf"][:2]
@@ -169,7 +191,7 @@ def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiv
     frame = claims_frame(rows, pd.DataFrame({"claim": []}), {})
     row = frame.iloc[0]
     assert not row["robust"] and row["robust"] is not None
-    assert row["flipped_by"] == "x=b (1 of 1)" and row["best_case"] == "x=b (scored by: r1)"
+    assert row["flipped_by"].startswith("x=b (+1") and row["best_case"] == "x=b (scored by: r1)"
     assert row["best_case_verdict"] == "reproduced" and row["cases"] == 2 and row["multiverse"] == "hspf_readings"
 
 
@@ -178,5 +200,14 @@ def test_a_flip_is_blamed_on_the_choice_that_changes_it_not_on_those_that_ride_a
     cases = tuple(_case(f"x={x}", {"x": x}, outcome, reading=r) for x in ("a", "b")
                   for r, outcome in (("r1", Outcome.NOT_REPRODUCED), ("r2", Outcome.REPRODUCED)))
     robustness = Robustness(CLAIM, cases)
-    assert robustness.flips == [(READING, "r2", 2, 2)]
-    assert "scored by 'r2' (2 of 2)" in robustness.summary
+    assert [(e.choice, e.alternative, e.flips, e.compared) for e in robustness.moving] == [(READING, "r2", 2, 2)]
+    assert "scored by 'r2' (2 of 2 decisive verdicts conflict)" in robustness.summary
+
+
+def test_a_choice_that_leaves_the_runs_as_they_are_has_no_effect_exactly():
+    from replication.evidence.robustness import paired_effect
+
+    effect, p = paired_effect(RUNS, dict(RUNS))
+    assert (effect.value, effect.low, effect.high, p) == (0.0, 0.0, 0.0, 1.0) and effect.method == "the same runs"
+    effect, p = paired_effect({0: 1.0}, {0: 2.0})  # one shared run: nothing to pair
+    assert effect is None and np.isnan(p)

@@ -12,10 +12,10 @@ import pandas as pd
 import pytest
 from hydra import compose, initialize_config_dir
 
+from replication.evidence.quantities import quantity
 from replication.paths import CONF_DIR, resolve
 from replication.report.index import write_index
 from replication.report.published import load_published
-from replication.report.quantities import quantity
 from replication.report.render import ENVIRONMENT, browser, open_in_browser
 from replication.report.summary import experiment_configs, summary_table
 from replication.report.tables import KEYS, TableKind
@@ -129,8 +129,9 @@ def test_matched_cells_name_every_published_cell_a_table_matched(name):
     """For every experiment that compares with a paper table: each cell its tables matched gets an entry."""
     if not PUBLISHED.exists():
         pytest.skip("../shared is not beside the project")
-    from replication.runner.config import at_scale, expand
     from omegaconf import OmegaConf
+
+    from replication.runner.config import at_scale, expand
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={name}", "scale=quick", "experiment.runs.quick=3"])
@@ -260,7 +261,7 @@ def test_claims_csv_has_one_row_per_claim_with_a_verdict_and_its_interval(report
 
 
 def test_no_interval_in_the_reports_leaves_its_metrics_range(reports):
-    from replication.report.quantities import quantity
+    from replication.evidence.quantities import quantity
 
     for folder in (reports / "gps_qmcpf", reports / "hspf_ungm"):
         for spec in experiment_configs()[folder.name]["report"].get("tables", []):

@@ -15,10 +15,10 @@ synthetic scene, a sequence not in the list) is left out.
 
 import pandas as pd
 
+from replication.evidence.quantities import quantity
+from replication.evidence.statistics import stratified_mean
+from replication.evidence.verdict import MIN_RUNS
 from replication.report.figures import parse_condition
-from replication.report.quantities import quantity
-from replication.report.statistics import stratified_mean
-from replication.report.verdict import MIN_RUNS
 from replication.scenes.otb import otb_attributes
 
 METRICS = ("precision20", "success_auc")  # OTB's two scores
@@ -45,7 +45,7 @@ def sequence_attributes(records: pd.DataFrame, experiment: dict) -> pd.DataFrame
 def attribute_scores(records: pd.DataFrame, experiment: dict, metrics=METRICS) -> pd.DataFrame:
     """One row per attribute carried by a sequence here and per (method, series), in OTB's attribute
     order: ``attribute`` (code), ``meaning``, ``sequences`` (those carrying it, sorted), ``runs`` (the
-    fewest on one of them), and an :class:`~replication.report.statistics.Estimate` per metric."""
+    fewest on one of them), and an :class:`~replication.evidence.statistics.Estimate` per metric."""
     meanings = otb_attributes()[0]
     known = sequence_attributes(records, experiment)
     rows = []

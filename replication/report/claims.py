@@ -27,20 +27,18 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from replication.evidence.comparisons import Effect, OrderTest, best_test, order_test
+from replication.evidence.inference import ALPHA, Test, mean_test, proportion_test, said_p, sign_test
+from replication.evidence.quantities import quantity
+from replication.evidence.statistics import Estimate
+from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
 from replication.paths import CONF_DIR
 from replication.qmc import discrepancy_table
-from replication.report.quantities import quantity
-from replication.report.ranking import rankings, unreliable
-from replication.report.statistics import Estimate, estimate, paired_difference
-from replication.report.tables import Table, pair
-from replication.report.verdict import Outcome, Verdict, too_few
+from replication.report.published import cells as published_cells
+from replication.evidence.ranking import rankings, unreliable
+from replication.report.tables import Table, match, pair
 
 CLAIMS_DIR = CONF_DIR / "claims"
-# A "best" claim holds when the method ranks first in at least 95% of the bootstrap resamples (the level
-# of every interval here) and fails when it does in at most 5% (so also when another method's P(best) is
-# at least 0.95); between, the sequences and runs leave it open.
-FIRST = 0.95
-NOT_FIRST = 0.05
 
 
 @dataclass(frozen=True)
@@ -77,17 +75,29 @@ class Paper:
 
 @dataclass(frozen=True)
 class Check:
-    """One comparison inside a reading: what was compared, the number that decided it, its verdict."""
+    """One comparison inside a reading: what was compared, the number that decided it, its verdict (with the
+    p-values it rests on: :class:`Result` applies Holm's correction across the reading's checks)."""
 
     what: str
     verdict: Verdict
     estimate: Estimate | None = None
     unit: str = ""
     reference: float | None = None  # where the claim's line is: the paper's value, a bound, zero difference
+    per_run: dict[int, float] = field(default_factory=dict)  # the statistic per repetition (for the multiverse)
 
     @property
     def number(self) -> str:
         return "" if self.estimate is None else f"{self.estimate}{self.unit}"
+
+    @property
+    def p_values(self) -> tuple[float, float]:
+        """(p_for, p_against); a check decided without a test (a deterministic comparison, a stored cell
+        verdict of old) counts as certain either way, an untestable one as neither."""
+        v = self.verdict
+        if v.p_for is not None or v.p_against is not None:
+            return (math.nan if v.p_for is None else v.p_for, math.nan if v.p_against is None else v.p_against)
+        return {Outcome.REPRODUCED: (0.0, 1.0), Outcome.NOT_REPRODUCED: (1.0, 0.0),
+                Outcome.INCONCLUSIVE: (1.0, 1.0), Outcome.NOT_TESTABLE: (math.nan, math.nan)}[v.outcome]
 
 
 @dataclass(frozen=True)
@@ -100,23 +110,30 @@ class Result:
 
     @classmethod
     def of(cls, checks: list[Check]) -> "Result":
-        """Every check reproduced: reproduced; any not reproduced: not reproduced; else inconclusive;
-        no check testable: not testable (with the first check's reason)."""
+        """The reading's verdict by :func:`~replication.evidence.verdict.decide`: not reproduced where some
+        check's evidence against the claim survives Holm across the testable checks, reproduced where every
+        testable check holds at 5 %, else inconclusive; not testable where no check is (with the first
+        check's reason).  A check's own verdict is re-stated where Holm changes it."""
         if not checks:
             return cls(Verdict(Outcome.NOT_TESTABLE, "no runs to test it on"))
-        testable = [c for c in checks if c.verdict.outcome is not Outcome.NOT_TESTABLE]
-        if not testable:
+        p_for, p_against = np.array([c.p_values for c in checks]).T
+        codes, reading, adjusted = decide(p_for, p_against)
+        checks = [_after_holm(c, OUTCOMES[code], p, len(checks)) for c, code, p in zip(checks, codes, adjusted)]
+        outcome = OUTCOMES[int(reading)]
+        if outcome is Outcome.NOT_TESTABLE:
             return cls(Verdict(Outcome.NOT_TESTABLE, checks[0].verdict.why), tuple(checks), checks[0])
-        for outcome in (Outcome.NOT_REPRODUCED, Outcome.INCONCLUSIVE):
-            deciding = next((c for c in testable if c.verdict.outcome is outcome), None)
-            if deciding:
-                break
-        else:
-            outcome, deciding = Outcome.REPRODUCED, testable[0]
-        held = sum(c.verdict.outcome is Outcome.REPRODUCED for c in testable)
+        testable = [i for i, c in enumerate(checks) if c.verdict.outcome is not Outcome.NOT_TESTABLE]
+        if outcome is Outcome.NOT_REPRODUCED:
+            i = min((i for i in testable if checks[i].verdict.outcome is outcome), key=lambda i: adjusted[i])
+        else:  # the weakest check: the largest p-value for the claim
+            i = max(testable, key=lambda i: np.nan_to_num(p_for[i], nan=1.0))
+        deciding = checks[i]
+        held = sum(c.verdict.outcome is Outcome.REPRODUCED for c in checks)
         said = "; ".join(filter(None, [deciding.number, deciding.verdict.why]))
         why = f"{held} of {len(testable)} checks hold; {deciding.what}" + (f": {said}" if said else "")
-        return cls(Verdict(outcome, why), tuple(checks), deciding)
+        p = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_for[i]
+        return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(p if outcome is Outcome.NOT_REPRODUCED
+                                                                     else p_against[i])), tuple(checks), deciding)
 
     def as_dict(self) -> dict:
         def check(c: Check) -> dict:
@@ -124,10 +141,21 @@ class Result:
             return {"what": c.what, "verdict": c.verdict.as_dict(), "number": c.number,
                     "value": _number(e.value) if e else None, "low": _number(e.low) if e else None,
                     "high": _number(e.high) if e else None, "runs": e.runs if e else None,
-                    "reference": c.reference}
+                    "reference": c.reference, "per_run": {str(k): _number(v) for k, v in c.per_run.items()}}
 
         return {"verdict": self.verdict.as_dict(), "checks": [check(c) for c in self.checks],
                 "deciding": check(self.deciding) if self.deciding else None}
+
+
+def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) -> Check:
+    """The check with the outcome the reading's family gives it (its own test's, unless Holm undoes it)."""
+    if outcome is check.verdict.outcome or check.verdict.outcome is Outcome.NOT_TESTABLE:
+        return check
+    own = check.verdict
+    why = f"{own.why}; not significant after Holm across {family} checks (p = {adjusted:.2g})" \
+        if own.outcome is Outcome.NOT_REPRODUCED else own.why
+    return Check(check.what, Verdict(outcome, why, own.p_for, own.p_against), check.estimate, check.unit,
+                 check.reference, check.per_run)
 
 
 class ClaimTest:
@@ -141,14 +169,14 @@ class ClaimTest:
         super().__init_subclass__(**kwargs)
         ClaimTest.registry[cls.name] = cls
 
-    def __init__(self, spec: dict, experiment: dict):
-        self.spec, self.experiment = spec, experiment
+    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame | None = None):
+        self.spec, self.experiment, self.published = spec, experiment, published
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict) -> "ClaimTest":
+    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame | None = None) -> "ClaimTest":
         if spec.get("test") not in cls.registry:
             raise ValueError(f"unknown claim test {spec.get('test')!r}; known: {sorted(cls.registry)}")
-        return cls.registry[spec["test"]](spec, experiment)
+        return cls.registry[spec["test"]](spec, experiment, published)
 
     def checks(self, records: pd.DataFrame, tables: dict[str, Table]) -> list[Check]:
         raise NotImplementedError
@@ -165,19 +193,20 @@ class ClaimTest:
 class Order(ClaimTest):
     """``order: [A, [B, C], D]``: A beats B and C, each of which beats D, on ``metric``, at each condition.
 
-    Each pair is judged by the mean paired difference over runs that filtered
-    the same data (BCa bootstrap): reproduced when its interval lies on the
-    claimed side of zero, not reproduced when it lies on the other side or at
-    zero, inconclusive when it straddles zero.  ``tolerance`` (a fraction of
-    the beaten method's mean) turns "better" into "no worse than by more than
-    that" (a claim of equal cost, say).
+    Each pair is a check on the runs that filtered the same data
+    (:func:`~replication.evidence.comparisons.order_test`): Student's paired
+    t-test (McNemar's exact test for yes/no outcomes) in the claimed direction,
+    and, where ``size:`` names the paper's table, the paper's own gap between
+    the two (a difference, or with ``kind: ratio`` a ratio) against ours.
+    ``tolerance`` (a fraction of the beaten method's mean) turns "better" into
+    "no worse than by more than that" (a claim of equal cost, say).
     """
 
     name = "order"
 
     def checks(self, records, tables):
         metric, scale = self.spec["metric"], self.spec.get("scale", 1.0)
-        lower = quantity(metric).lower_is_better
+        kind = quantity(metric)
         unit = self.spec.get("unit", "")
         groups = [_listed(g) for g in self.spec["order"]]
         found = []
@@ -188,10 +217,75 @@ class Order(ClaimTest):
                     what = f"{a} - {b}" + (f" at {condition}" if condition else "")
                     if paired.empty:
                         continue
-                    difference = paired_difference(paired["method"] * scale, paired["baseline"] * scale)
-                    allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean() * scale)
-                    found.append(Check(what, _judge_sign(difference, lower, allowed), difference, unit, 0.0))
+                    allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean())
+                    better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
+                    verdict, difference = _order_check(better, worse, kind, scale, allowed,
+                                                       self.effect(a, b, condition))
+                    per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
+                    found.append(Check(what, verdict, difference, unit, 0.0, per_run))
         return found
+
+    def effect(self, better: str, worse: str, condition: str) -> Effect | None:
+        """The paper's numbers for the pair at our ``condition``, matched with its cells as our table named by
+        ``size.table`` matches them (None where ``size`` names none, or a number is missing)."""
+        size = self.spec.get("size")
+        if not size or self.published is None:
+            return None
+        table = next(t for t in self.experiment["report"]["tables"] if t["name"] == size["table"])
+        theirs = published_cells(self.published, self.experiment["paper"], table["paper_table"],
+                                 table.get("paper_metric", table.get("metric")))
+        methods = size.get("methods", {})
+        values = [match(theirs, str(methods.get(m, m)), condition, table)["number"] for m in (better, worse)]
+        if any(len(v) != 1 or not np.isfinite(v.iloc[0]) for v in values):
+            return None
+        return Effect(float(values[0].iloc[0]), float(values[1].iloc[0]), size.get("kind", "difference"))
+
+
+def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allowed: float,
+                 paper: Effect | None) -> tuple[Verdict, Estimate]:
+    """One pair's verdict (before the reading's Holm) and the paired difference better - worse shown with
+    it, in the claim's units (``scale``)."""
+    runs = len(better)
+    binary = kind.proportion
+    unit = kind.high * scale if binary else scale  # yes/no outcomes are tested as 0 or 1
+    as_rates = Effect(paper.better / unit, paper.worse / unit, "difference") if binary and paper else paper
+    tested = order_test(better * scale / unit, worse * scale / unit, kind.lower_is_better, binary,
+                        allowed * scale / unit, as_rates)
+    difference = _shown(tested.gain, unit * (-1 if kind.lower_is_better else 1), runs)
+    few = too_few(runs)
+    if few:
+        return few, difference
+    return _order_verdict(tested, paper, unit, binary), difference
+
+
+def _shown(test: Test, factor: float, runs: int) -> Estimate:
+    """A gain's test as the difference better - worse in the claim's units (``factor`` flips the sign where
+    lower is better)."""
+    ends = sorted([float(test.low) * factor, float(test.high) * factor])
+    return Estimate(float(test.value) * factor, *ends, runs, f"paired {test.method}, 90% CI")
+
+
+def _order_verdict(tested: OrderTest, paper: Effect | None, unit: float, binary: bool) -> Verdict:
+    p_for, p_against = _finite(tested.p_for), _finite(tested.p_against)
+    if p_for is None and p_against is None:
+        return Verdict(Outcome.NOT_TESTABLE, "every run gives the same difference: no test")
+    sized = tested.size is not None
+    if p_against is not None and p_against < ALPHA:
+        if sized and p_for is not None and p_for < ALPHA:
+            why = f"the sign agrees, the size does not: the paper's {paper} is absent, {said_p(p_against)}"
+        elif sized:
+            why = f"the paper's {paper} is absent here, {said_p(p_against)}"
+        else:
+            why = f"the other way round, {said_p(p_against)}"
+        return Verdict(Outcome.NOT_REPRODUCED, why, p_for, p_against)
+    if p_for is not None and p_for < ALPHA:
+        size = f"; consistent with the paper's {paper}" if sized else ""
+        return Verdict(Outcome.REPRODUCED, f"{said_p(p_for)}{size}", p_for, p_against)
+    smallest = tested.detectable * unit
+    detect = f"; {tested.gain.runs} runs detect {smallest:.3g} with 80% power" \
+        if math.isfinite(smallest) and smallest > 0 and not binary else ""
+    said = said_p(p_for) if p_for is not None else "every run ties"
+    return Verdict(Outcome.INCONCLUSIVE, f"{said}{detect}", p_for, p_against)
 
 
 class Cells(ClaimTest):
@@ -222,35 +316,58 @@ class Cells(ClaimTest):
 
 
 class Threshold(ClaimTest):
-    """``method`` at ``condition`` reaches a bound: ``at_least`` or ``at_most``, on the statistic's interval."""
+    """``method`` at ``condition`` reaches a bound, ``at_least`` or ``at_most``: the exact sign test of its
+    median (``statistic: median``), the exact binomial test of a yes/no rate, else the t-test of its mean,
+    one-sided each way."""
 
     name = "threshold"
 
     def checks(self, records, tables):
         spec = self.spec
         chosen = records[(records["method"] == spec["method"]) & (records["condition"] == spec.get("condition", ""))]
+        metric = spec["metric"]
+        chosen = chosen[np.isfinite(chosen[metric].astype(float))]
         if chosen.empty:
             return []
-        metric = spec["metric"]
-        found = estimate(chosen[metric].to_numpy(float), quantity(metric), spec.get("statistic", "mean"))
+        kind = quantity(metric)
+        values = chosen[metric].to_numpy(float)
         bound, above = (spec["at_least"], True) if "at_least" in spec else (spec["at_most"], False)
-        what = f"{spec['method']} {metric} {'>=' if above else '<='} {bound:g}"
-        verdict = too_few(found.runs)
-        if verdict is None:
-            low, high = (found.low, found.high) if above else (-found.high, -found.low)
-            bound_ = bound if above else -bound
-            verdict = (Verdict(Outcome.REPRODUCED) if low >= bound_ else Verdict(Outcome.NOT_REPRODUCED)
-                       if high < bound_ else Verdict(Outcome.INCONCLUSIVE, "the interval straddles the bound"))
-        return [Check(what, verdict, found, spec.get("unit", ""), float(bound))]
+        if kind.proportion:
+            test = proportion_test(int(round(values.sum() / kind.high)), len(values), bound / kind.high)
+            factor = kind.high
+        else:
+            test = (sign_test if spec.get("statistic") == "median" else mean_test)(values, bound)
+            factor = 1.0
+        shown = Estimate(float(test.value) * factor, float(test.low) * factor, float(test.high) * factor,
+                         len(values), f"{test.method}, 90% CI")
+        what = f"{spec['method']} {spec.get('statistic', 'mean')} {metric} {'>=' if above else '<='} {bound:g}"
+        p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
+        verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
+        return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
+                      dict(zip(chosen["repetition"].astype(int), values)))]
+
+
+def _threshold_verdict(p_for: float | None, p_against: float | None, against: str = "the other side of the bound",
+                       then: str = "") -> Verdict:
+    """A one-sided test each way: its verdict before the reading's Holm (``then``: said after the why)."""
+    if p_for is None and p_against is None:
+        return Verdict(Outcome.NOT_TESTABLE, f"every run ties: no test{then}")
+    if p_for is not None and p_for < ALPHA:
+        return Verdict(Outcome.REPRODUCED, f"{said_p(p_for)}{then}", p_for, p_against)
+    if p_against is not None and p_against < ALPHA:
+        return Verdict(Outcome.NOT_REPRODUCED, f"{against}, {said_p(p_against)}{then}", p_for, p_against)
+    return Verdict(Outcome.INCONCLUSIVE, f"{said_p(p_for)} for, {said_p(p_against)} against{then}", p_for,
+                   p_against)
 
 
 class Best(ClaimTest):
     """``method`` ranks first in mean ``metric`` over the sequences (the condition variable ``over``,
-    default ``scene``; ``group``: one value of the ranking's ``by`` variable), decided by its probability
-    of ranking first under the two-level bootstrap of :mod:`replication.report.ranking`, not by the
-    means: reproduced at ``P(best) >=`` :data:`FIRST`, not reproduced at ``<=`` :data:`NOT_FIRST` (which
-    also holds whenever another method's is at least :data:`FIRST`), inconclusive between.  A ranking
-    that is not reliable (too few runs or sequences, sequences cut short) decides nothing."""
+    default ``scene``; ``group``: one value of the ranking's ``by`` variable): one check per competitor, the
+    paired t-test over the sequences of the per-sequence difference of their means
+    (:func:`~replication.evidence.comparisons.best_test`).  Reproduced where it beats every competitor at 5 %;
+    not reproduced where some competitor is better, after Holm across them.  P(best) and the rank interval of
+    the two-level bootstrap (:mod:`replication.evidence.ranking`) are shown beside it and decide nothing.  A
+    ranking that is not reliable (too few runs or sequences, sequences cut short) decides nothing."""
 
     name = "best"
 
@@ -259,25 +376,27 @@ class Best(ClaimTest):
         found = rankings(records, self.spec).get(self.spec.get("group", ""))
         if found is None or method not in found.methods:
             return []
-        i, top = found.index(method), int(np.argmax(found.p_best))
-        p = float(found.p_best[i])
-        what = (f"{method} first in mean {metric} over {len(found.sequences)} sequences x {found.runs} "
-                f"run(s): P(best), two-level bootstrap")
-        rank = found.rank(i)
-        leader = f"; first most often: {found.methods[top]} ({found.p_best[top]:.2f})" if top != i else ""
+        i = found.index(method)
+        per_sequence = np.stack([found.per_sequence(j) for j in range(len(found.methods))], axis=-1)
+        tested = best_test(per_sequence, i, found.lower_is_better)
         caveat = unreliable(found, self.experiment)
-        if caveat:
-            outcome, against = Outcome.NOT_TESTABLE, ""
-        elif p >= FIRST:
-            outcome, against = Outcome.REPRODUCED, f" >= {FIRST}"
-        elif p <= NOT_FIRST:
-            outcome, against = Outcome.NOT_REPRODUCED, f" <= {NOT_FIRST}"
-        else:
-            outcome, against = Outcome.INCONCLUSIVE, f", between {NOT_FIRST} and {FIRST}"
-        said = f"P(best) = {p:.2f}{against}, rank [{rank.low:.0f}, {rank.high:.0f}]{leader}"
-        verdict = Verdict(outcome, f"{caveat}; {said}" if caveat else said)
-        estimate = Estimate(p, math.nan, math.nan, len(found.sequences) * found.runs, "two-level bootstrap")
-        return [Check(what, verdict, estimate, reference=FIRST)]
+        rank = found.rank(i)
+        description = f"P(best) = {found.p_best[i]:.2f}, rank [{rank.low:.0f}, {rank.high:.0f}] (description only)"
+        checks = []
+        others = [m for m in found.methods if m != method]
+        sign = -1.0 if found.lower_is_better else 1.0
+        for j, other in enumerate(others):
+            what = f"{method} - {other}, mean {metric} over {len(found.sequences)} sequences x {found.runs} run(s)"
+            difference = Estimate(sign * float(tested.gain.value[j]),
+                                  *sorted([sign * float(tested.gain.low[j]), sign * float(tested.gain.high[j])]),
+                                  len(found.sequences), "sequence-level paired t, 90% CI")
+            if caveat:
+                verdict = Verdict(Outcome.NOT_TESTABLE, f"{caveat}; {description}")
+            else:
+                verdict = _threshold_verdict(_finite(tested.p_for[j]), _finite(tested.p_against[j]),
+                                             f"{other} is better", f"; {description}")
+            checks.append(Check(what, verdict, difference, reference=0.0))
+        return checks
 
 
 class Uniformity(ClaimTest):
@@ -298,20 +417,6 @@ class Uniformity(ClaimTest):
             found.append(Check(f"{spec['set']} vs {spec['than']}, s = {int(row['s'])}",
                                Verdict(outcome, f"{ours:.2e} vs {other:.2e}")))
         return found
-
-
-def _judge_sign(difference: Estimate, lower_is_better: bool, allowed: float) -> Verdict:
-    """A paired difference (claimed better minus claimed worse) against the claim that it is better."""
-    few = too_few(difference.runs)
-    if few:
-        return few
-    low, high = (-difference.high, -difference.low) if lower_is_better else (difference.low, difference.high)
-    low, high = low + allowed, high + allowed  # in favour of the claim: positive
-    if low > 0:
-        return Verdict(Outcome.REPRODUCED)
-    if high <= 0:
-        return Verdict(Outcome.NOT_REPRODUCED, "the other way round" if high < 0 else "no difference")
-    return Verdict(Outcome.INCONCLUSIVE, "the interval contains zero")
 
 
 # -- claims as data ------------------------------------------------------------------------------------
@@ -336,15 +441,17 @@ def load_papers(directory: Path = CLAIMS_DIR) -> tuple[Paper, ...]:
     return tuple(paper for _, paper in sorted(papers, key=lambda item: item[0]))
 
 
-def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table]) -> dict:
-    """The results of every reading that names experiment ``name``: {claim id: {reading name: result}}."""
+def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table],
+             published: pd.DataFrame | None = None) -> dict:
+    """The results of every reading that names experiment ``name``: {claim id: {reading name: result}}
+    (``published``: the paper's numbers, whose sizes the ``order`` tests compare with ours)."""
     results = {}
     for paper in load_papers():
         for claim in paper.claims:
             for reading in claim.readings:
                 if reading.experiment != name:
                     continue
-                test = ClaimTest.of(reading.test, experiment)
+                test = ClaimTest.of(reading.test, experiment, published)
                 checks = test.checks(records, tables) if len(records) or not test.needs_runs else []
                 results.setdefault(claim.id, {})[reading.name] = Result.of(checks).as_dict()
     return results
@@ -364,3 +471,8 @@ def _float(value) -> float:
 
 def _number(value) -> float | None:
     return float(value) if value is not None and math.isfinite(value) else None
+
+
+def _finite(value) -> float | None:
+    value = float(value)
+    return value if math.isfinite(value) else None

@@ -13,6 +13,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
+from replication.evidence.verdict import RULES, Verdict
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.claims import evaluate
@@ -21,7 +22,6 @@ from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
 from replication.report.scale import scale_changes, scale_note
 from replication.report.tables import TableKind
-from replication.report.verdict import RULES, Verdict
 from replication.run import Run
 from replication.runner.config import experiment_at_scale
 from replication.runner.results import frames, tidy, write
@@ -71,7 +71,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     compared = [entry for table in built.values() for entry in table.cells]
     matched = {entry["published_index"] for entry in compared}
     verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
-    claims = evaluate(experiment["name"], experiment, records, built)
+    claims = evaluate(experiment["name"], experiment, records, built, published)
     changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)

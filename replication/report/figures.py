@@ -13,7 +13,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
-from replication.report.aggregate import parse_condition, summarise  # noqa: E402
+from replication.evidence.aggregate import parse_condition, summarise  # noqa: E402
 from replication.report.published import cells, load_published  # noqa: E402
 from replication.report.style import (  # noqa: E402
     BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,

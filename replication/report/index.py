@@ -19,7 +19,7 @@ from replication.report.render import render
 from replication.report.scale import scale_note
 from replication.report.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table
-from replication.report.verdict import RULES
+from replication.evidence.verdict import RULES
 
 TITLE = "Particle-filter tracking papers: replication report"
 
@@ -74,6 +74,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             rules=RULES,
             counts=counts(cells),
             benchmark=(reports / "benchmark" / "index.html").exists(),
+            calibration=(reports / "calibration" / "index.html").exists(),
             pdf=(reports / "replication.pdf").exists(),
             generated=datetime.date.today().isoformat(),
             version=replication.__version__,

@@ -25,7 +25,7 @@ from matplotlib.patches import Rectangle
 from PIL import Image
 
 from replication.metrics.mot import BOX, clear_mot_matches
-from replication.report.aggregate import parse_condition
+from replication.evidence.aggregate import parse_condition
 from replication.report.style import method_label, save
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
 from replication.tasks.mot import frame_table

@@ -2,21 +2,30 @@
 
 A *case* is one universe (an alternative for each open choice, see
 :mod:`replication.runner.multiverse`) tested with one of the claim's scoring
-readings (``conf/claims/<paper>.yaml``).  A claim is *robust* when every
-testable case gives the same verdict; otherwise it *depends on the reading*,
-and :class:`Robustness` says which alternatives flip it (the share of their
-cases whose verdict differs from the default's) and the best case for the
-paper: the case that comes closest to the claim holding, with its number.
+readings (``conf/claims/<paper>.yaml``).  Whether the claim's verdict depends
+on a choice is decided by the choice's paired effect on the deciding
+statistic (:mod:`replication.evidence.robustness`): *robust* unless some
+alternative moves that statistic significantly (Holm across the alternatives)
+and its verdict with it.  :class:`Robustness` gives each alternative's effect
+with its interval and the best case for the paper: the case that comes
+closest to the claim holding, with its number.
 """
 
 import json
+import math
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
+from replication.evidence.verdict import RULES, Outcome, Verdict
+from replication.evidence.inference import said_p
+from replication.evidence.robustness import DECISIVE, ChoiceEffect, adjust, paired_effect
+from replication.evidence.statistics import Estimate
 from replication.paths import resolve
 from replication.report.claims import Claim, ClaimTest, evaluate, load_papers
 from replication.report.published import load_published
@@ -24,7 +33,6 @@ from replication.report.render import render
 from replication.report.scale import scale_note
 from replication.report.style import OUTCOME_COLOURS
 from replication.report.tables import TableKind
-from replication.report.verdict import RULES, Outcome, Verdict
 from replication.runner.multiverse import Multiverse
 from replication.runner.store import Store
 
@@ -73,20 +81,17 @@ class Robustness:
         return [c for c in self.cases if c.verdict.outcome is not Outcome.NOT_TESTABLE]
 
     @property
-    def robust(self) -> bool | None:
-        """The same verdict in every testable case; None when fewer than two cases are testable."""
-        testable = self.testable
-        return None if len(testable) < 2 else len({c.verdict.outcome for c in testable}) == 1
+    def deciding(self) -> str:
+        """The statistic whose movement is tested: the check that decided the default case."""
+        return (self.default.deciding or {}).get("what", "")
 
-    @property
-    def flips(self) -> list[tuple[str, str, int, int]]:
-        """(choice, alternative, flipped, compared) for each alternative other than the default under which
-        the verdict changes, most often first.
-
-        A case under the alternative is compared with its twin: the case that differs from it only in
-        that choice, set to its default (same universe otherwise, same scoring reading), so a flip is
-        the alternative's own doing.  Where a design has no twins (Sobol points), every case under the
-        alternative is compared with the default case instead."""
+    @cached_property
+    def effects(self) -> list[ChoiceEffect]:
+        """Each alternative other than the default: its paired effect on the deciding statistic against its
+        twin (the case that differs only in that choice, set to its default; where a design has no twins,
+        Sobol points, the default case), and how many of its cases' verdicts differ from the twin's.  A
+        scoring reading, and a statistic with no per-run values (a published cell, a ranking), count only
+        conflicting decisive verdicts (reproduced against not reproduced)."""
         testable = self.testable
         cases = {c.picks: c for c in testable}
         default_picks = dict(self.default.picks)
@@ -97,16 +102,40 @@ class Robustness:
             under = [c for c in testable if (choice, alternative) in c.picks]
             twins = [(c, cases.get(tuple((ch, default_picks[ch] if ch == choice else a) for ch, a in c.picks)))
                      for c in under]
-            pairs = [(c, t) for c, t in twins if t is not None] or [(c, self.default) for c in under]
-            flipped = sum(c.verdict.outcome is not t.verdict.outcome for c, t in pairs)
-            if flipped:
-                found.append((choice, alternative, flipped, len(pairs)))
-        return sorted(found, key=lambda f: -f[2] / f[3])
+            pairs = [(c, t) for c, t in twins if t is not None]
+            compared = "twin" if pairs else "default"
+            pairs = pairs or [(c, self.default) for c in under]
+            effect, p = (None, math.nan) if choice == READING else self._paired(pairs)
+            if choice == READING or effect is None:
+                compared = "readings"
+                flips = sum({c.verdict.outcome, t.verdict.outcome} == DECISIVE for c, t in pairs)
+            else:
+                flips = sum(c.verdict.outcome is not t.verdict.outcome for c, t in pairs)
+            found.append((choice, alternative, effect, p, flips, len(pairs), compared))
+        return adjust(found)
+
+    def _paired(self, pairs: list[tuple[Case, Case]]) -> tuple[Estimate | None, float]:
+        """The deciding statistic's paired effect in the first pair that has it per run on both sides."""
+        for case, twin in pairs:
+            ours, theirs = (_per_run(c, self.deciding) for c in (case, twin))
+            if ours and theirs:
+                return paired_effect(ours, theirs)
+        return None, math.nan
+
+    @property
+    def moving(self) -> list[ChoiceEffect]:
+        return [e for e in self.effects if e.moves]
+
+    @property
+    def robust(self) -> bool | None:
+        """No alternative moves the verdict; None when fewer than two cases are testable."""
+        return None if len(self.testable) < 2 else not self.moving
 
     @property
     def flipped_by(self) -> list[str]:
-        """The flips as a reader sees them: 'bests=rescored (4 of 8)', "scored by 'the other rule' (2 of 2)"."""
-        return [f"{_alternative(choice, alternative)} ({n} of {m})" for choice, alternative, n, m in self.flips]
+        """The alternatives the verdict depends on, as a reader sees them: 'bests=rescored (+0.3 [0.1, 0.5],
+        Holm p = 0.01)', "scored by 'the other rule' (2 of 2 decisive verdicts conflict)"."""
+        return [f"{_alternative(e.choice, e.alternative)} ({_effect(e)})" for e in self.moving]
 
     @property
     def best_case(self) -> Case:
@@ -117,14 +146,20 @@ class Robustness:
         testable = self.testable
         if self.robust is None:
             return f"not testable across readings ({len(testable)} of {len(self.cases)} cases testable)"
+        tested = [e for e in self.effects if e.effect is not None]
         if self.robust:
-            return f"robust: {testable[0].verdict.outcome.value} in all {len(testable)} cases"
+            largest = max((e for e in tested if np.isfinite(e.effect.value)), key=lambda e: abs(e.effect.value),
+                          default=None)
+            said = (f"; largest effect on {self.deciding}: {_alternative(largest.choice, largest.alternative)} "
+                    f"{_effect(largest)}") if largest else ""
+            return (f"robust: no open choice moves the verdict ({len(self.effects)} alternatives, "
+                    f"{len(testable)} cases){said}")
         flips = self.flipped_by
         flips = "; ".join(flips[:SHOWN_FLIPS]) + (f"; {len(flips) - SHOWN_FLIPS} more" if len(flips) > SHOWN_FLIPS
                                                    else "")
         best = self.best_case
         number = f" ({best.deciding['number']})" if best.deciding and best.deciding.get("number") else ""
-        return (f"depends on the reading: {self.default.verdict.outcome.value} by default, flipped under {flips}; "
+        return (f"depends on the reading: moved by {flips}; "
                 f"best case for the paper: {best.verdict.outcome.value}{number} under {best.label}")
 
     def as_dict(self) -> dict:
@@ -133,9 +168,28 @@ class Robustness:
                     "verdict": c.verdict.as_dict(),
                     "deciding": c.deciding, "checks": list(c.checks)}
 
+        def effect(e: ChoiceEffect) -> dict:
+            return {"choice": e.choice, "alternative": e.alternative, "effect": e.effect.value if e.effect else None,
+                    "low": e.effect.low if e.effect else None, "high": e.effect.high if e.effect else None,
+                    "p": None if math.isnan(e.p) else e.p, "holm": None if math.isnan(e.adjusted) else e.adjusted,
+                    "flips": e.flips, "compared": e.compared, "paired": e.paired, "moves": e.moves}
+
         return {"robust": self.robust, "summary": self.summary, "cases": [case(c) for c in self.cases],
-                "flips": [list(f) for f in self.flips], "flipped_by": self.flipped_by,
-                "best_case": case(self.best_case)}
+                "deciding": self.deciding, "effects": [effect(e) for e in self.effects],
+                "flipped_by": self.flipped_by, "best_case": case(self.best_case)}
+
+
+def _per_run(case: Case, what: str) -> dict[int, float]:
+    check = next((c for c in case.checks if c["what"] == what), None)
+    return {int(k): v for k, v in (check or {}).get("per_run", {}).items() if v is not None}
+
+
+def _effect(e: ChoiceEffect) -> str:
+    if e.effect is None:
+        return f"{e.flips} of {e.compared} decisive verdicts conflict"
+    if e.effect.method == "the same runs":
+        return "no effect: the same runs"
+    return f"{e.effect.value:+.3g} [{e.effect.low:.3g}, {e.effect.high:.3g}], Holm {said_p(e.adjusted)}"
 
 
 def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFrame) -> list[Robustness]:
@@ -148,8 +202,8 @@ def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFram
         for name in multiverse.experiments:
             experiment = multiverse.experiment_configs[universe.name, name]
             records = store_of(name).load(multiverse.runs[universe.name, name])
-            for claim, readings in evaluate(name, experiment, records, _tables(name, experiment, records,
-                                                                               claims, published)).items():
+            tables = _tables(name, experiment, records, claims, published)
+            for claim, readings in evaluate(name, experiment, records, tables, published).items():
                 results.setdefault(claim, {}).update(readings)
         for claim in claims:
             for reading in claim.readings:

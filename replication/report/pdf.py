@@ -37,7 +37,7 @@ from replication.report.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.report.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
 from replication.report.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.report.tables import Table  # noqa: E402
-from replication.report.verdict import RULES  # noqa: E402
+from replication.evidence.verdict import RULES  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
 FONT = 7.0  # table text, points: the smallest that reads in print (a long cell wraps rather than shrinks)
@@ -49,7 +49,7 @@ SUMMARY_COLUMNS = {  # the summary's columns as printed: heading -> how wide it 
     "paper": 10, "table": 5, "experiment / condition": 22, "method": 20, "metric": 21, "paper value": 18,
     "ours (95% CI)": 34, "verdict or reason": 60, "claim": 26,
 }
-SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (95% CI)": 30, "why": 60, "readings": 40}
+SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (90% CI)": 30, "why": 60, "readings": 40}
 
 
 def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path:
@@ -74,7 +74,7 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
             _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key], tallies),
                          widths=SCORECARD_COLUMNS,
                          subtitle=f"{paper.authors}; {paper.venue} ({paper.key}). Claims: {counted}.")
-        _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": [RULES]}), widths={"rules": 200})
+        _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": list(RULES)}), widths={"rules": 200})
         _table_pages(pdf, "Every published cell", _summary_frame(cells), widths=SUMMARY_COLUMNS,
                      subtitle="One row per published value: ours and the verdict where a table of ours "
                      "matched it, otherwise why not")
@@ -148,7 +148,7 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     return pd.DataFrame({
         "claim": [f"{r.claim.text} ({r.claim.source})" for r in rows],
         "verdict": [r.verdict.outcome.value for r in rows],
-        "deciding number (95% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
+        "deciding number (90% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
         "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
         "readings": [r.primary.reading.name + ("" if len(r.results) == 1 and r.multiverse is None
                                                else f"; {r.robustness}") for r in rows],

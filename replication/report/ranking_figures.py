@@ -8,14 +8,14 @@ import numpy as np
 import pandas as pd
 
 from replication.report.figures import NothingToDraw
-from replication.report.ranking import rankings, unreliable
+from replication.evidence.ranking import rankings, unreliable
 from replication.report.style import OUTCOME_COLOURS, axis_label, save
 
 LUMA = np.array([0.299, 0.587, 0.114])  # a colour's lightness: dark segments take white text
 
 
 def ranking(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """One row of two panels per ranking (:func:`~replication.report.ranking.rankings` of ``spec``):
+    """One row of two panels per ranking (:func:`~replication.evidence.ranking.rankings` of ``spec``):
     left, stacked bars of P(rank = k) per method, best first, with its P(best) and 95% rank interval;
     right, the matrix of P(row beats column).  A ranking that is not reliable says why above it."""
     found = rankings(records, spec)

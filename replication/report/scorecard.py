@@ -13,8 +13,9 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from replication.evidence.robustness import DECISIVE
+from replication.evidence.verdict import Outcome, Verdict
 from replication.report.claims import Claim, Paper, Reading
-from replication.report.verdict import Outcome, Verdict
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,8 @@ class ClaimRow:
     def robustness(self) -> str:
         """Whether the verdict is the same under every reading, or which reading it hinges on: across the
         paper's multiverse of run-level and scoring readings where it was run, else across the scoring
-        readings of the stored results."""
+        readings of the stored results (where it hinges only on readings that give conflicting decisive
+        verdicts)."""
         if self.multiverse is not None:
             return self.multiverse["summary"]
         judged = [r for r in self.results if r.verdict.outcome is not Outcome.NOT_TESTABLE]
@@ -66,8 +68,10 @@ class ClaimRow:
         outcomes = {r.verdict.outcome for r in judged}
         if len(outcomes) == 1:
             return f"the same under all {len(judged)} readings"
-        return "hinges on the reading: " + "; ".join(f"{r.verdict.outcome.value} under {r.reading.name}"
-                                                     for r in judged)
+        listed = "; ".join(f"{r.verdict.outcome.value} under {r.reading.name}" for r in judged)
+        if DECISIVE <= outcomes:  # each decisive verdict holds its error rate: a real conflict
+            return f"hinges on the reading: {listed}"
+        return f"no reading contradicts another (an inconclusive reading is no contradiction): {listed}"
 
 
 def claim_rows(papers: list[Paper], summaries: dict[str, dict]) -> dict[str, list[ClaimRow]]:

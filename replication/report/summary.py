@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from replication.evidence.verdict import Verdict
 from replication.paths import CONF_DIR, experiment_names
 from replication.report.tables import KEYS
-from replication.report.verdict import Verdict
 
 # -- the summary of every published cell --------------------------------------------------------------
 

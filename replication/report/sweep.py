@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication.errors import ConfigError
-from replication.report.aggregate import summarise
+from replication.evidence.aggregate import summarise
 from replication.report.figures import metric_vs_condition
 from replication.report.render import html_table, render
 

@@ -3,7 +3,7 @@
 Every kind turns records into a :class:`Table`: one row per (method,
 condition) of ours, and for the kinds that compare with the paper, the
 published cells each row was matched with (by :func:`match`, the one rule
-for that) and a :class:`~replication.report.verdict.Verdict`.
+for that) and a :class:`~replication.evidence.verdict.Verdict`.
 
 Add a kind by subclassing :class:`TableKind` with a new ``kind`` name and a
 ``build`` method; a spec in ``report.tables`` then names it.
@@ -17,15 +17,15 @@ from typing import ClassVar
 import numpy as np
 import pandas as pd
 
+from replication.evidence.quantities import quantity
+from replication.evidence.statistics import Estimate, paired_difference, proportion
+from replication.evidence.verdict import TOLERANCE, Outcome, Verdict, judge_band, judge_value, stability_bands
 from replication.qmc import discrepancy_table
-from replication.report.aggregate import summarise
+from replication.evidence.aggregate import summarise
 from replication.report.attributes import attribute_scores, carried_by
 from replication.report.modes import runs_keeping_both_modes
 from replication.report.published import cells
-from replication.report.quantities import quantity
-from replication.report.ranking import Ranking, rankings, unreliable
-from replication.report.statistics import Estimate, paired_difference, proportion
-from replication.report.verdict import Outcome, Verdict, judge_band, judge_value, too_few
+from replication.evidence.ranking import Ranking, rankings, unreliable
 
 FLOOR_FILTER = "point_mass"
 KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
@@ -177,11 +177,12 @@ class Comparison(TableKind):
         kind = kind.scaled(spec.get("scale", 1.0))
         ours = summarise(records, metric, spec.get("scale", 1.0), spec.get("statistic", "mean"))
         ours = ours[ours["runs"] > 0]
-        floor_low, excess = None, {}
+        floor_runs, excess = None, {}
         if metric == "rmse":
             floor = [m for m in methods if methods[m]["filter"] == FLOOR_FILTER]
             floors = ours[ours["method"].isin(floor)]
-            floor_low = floors["ci_low"].min() if len(floors) else None
+            # the floor at the condition where it is lowest: the weakest evidence that a value lies below it
+            floor_runs = floors.loc[floors["mean"].idxmin(), "values"] if len(floors) else None
             excess = excess_over_floor(records, floor)
         if spec.get("match"):  # the conditions the paper's table covers
             ours = ours[ours["condition"].isin(list(spec["match"]))]
@@ -191,7 +192,9 @@ class Comparison(TableKind):
             estimate = Estimate(row["mean"], row["ci_low"], row["ci_high"], row["runs"], row["interval"])
             hit = match(theirs, row["method"], row["condition"], spec)
             paper = float(hit["number"].iloc[0]) if len(hit) else math.nan
-            verdict = judge_value(paper, estimate, kind, spec.get("paper_runs"), floor_low)
+            verdict = judge_value(paper, row["values"], kind,
+                                  spec.get("statistic", "mean"), spec.get("paper_runs"), floor_runs,
+                                  spec.get("tolerance", TOLERANCE))
             shown = {"method": self.label(row["method"]), "condition": row["condition"] or "-",
                      "runs": row["runs"], "estimate": estimate, "ours": row["mean"], "ci_low": row["ci_low"],
                      "ci_high": row["ci_high"], "interval": row["interval"]}
@@ -204,12 +207,6 @@ class Comparison(TableKind):
             rows.append(shown)
             entries += [self.entry(i, shown, verdict, estimate) for i in hit.index]
         return Table(pd.DataFrame(rows), entries)
-
-
-def stability_bands(per: int = 10) -> dict[str, tuple[float, float]]:
-    """bis_pf's ratings as bands of the failure probability: good = no failure in 10 runs, medium = 2 or
-    more, poor = 5 or more; one failure in 10 (unrated by the paper) is split between good and medium."""
-    return {"good": (0.0, 1.5 / per), "medium": (1.5 / per, 4.5 / per), "poor": (4.5 / per, 1.0)}
 
 
 class Rating(TableKind):
@@ -226,9 +223,9 @@ class Rating(TableKind):
             hit = match(theirs, method, condition, self.spec)
             paper = hit["value"].iloc[0] if len(hit) else ""
             ours = next(name for name, (low, high) in bands.items() if low <= estimate.value <= high)
-            verdict = judge_band(paper, estimate, bands) if paper else None
+            verdict = judge_band(paper, failures, runs, bands) if paper else None
             row = {"method": self.label(method), "condition": condition or "-", "runs": runs,
-                   "failed runs": failures, "failure rate (Wilson 95% CI)": str(estimate), "rating": ours,
+                   "failed runs": failures, "failure rate (Clopper-Pearson 95% CI)": str(estimate), "rating": ours,
                    "paper": paper, "verdict": verdict}
             rows.append(row)
             entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
@@ -247,14 +244,15 @@ class Modes(TableKind):
         rows, entries = [], []
         for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
             shares = runs_keeping_both_modes(group, self.spec, self.experiment)
-            estimate = proportion(int((shares > 0.5).sum()), len(shares))
+            keeping = int((shares > 0.5).sum())
+            estimate = proportion(keeping, len(shares))
             hit = match(theirs, method, condition, self.spec)
             paper = hit["value"].iloc[0] if len(hit) else ""
             ours = "success" if estimate.value > 0.5 else "failure"
-            verdict = judge_band(paper, estimate, self.BANDS) if paper else None
+            verdict = judge_band(paper, keeping, len(shares), self.BANDS) if paper else None
             row = {"method": self.label(method), "condition": condition or "-", "runs": len(shares),
                    "two-mode frames (mean share)": round(float(shares.mean()), 3),
-                   "runs keeping both modes (Wilson 95% CI)": str(estimate), "ours": ours, "paper": paper,
+                   "runs keeping both modes (Clopper-Pearson 95% CI)": str(estimate), "ours": ours, "paper": paper,
                    "verdict": verdict}
             rows.append(row)
             entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
@@ -274,12 +272,15 @@ class Improvement(TableKind):
         if paired.empty:
             return Table(pd.DataFrame())
         scale = 100.0 / paired["baseline"].mean()
+        improvements = (paired["baseline"] - paired["method"]).to_numpy() * scale
         estimate = paired_difference(paired["baseline"], paired["method"]).scaled(scale)
         theirs = self.theirs()
         paper = float(theirs["number"].iloc[0]) if len(theirs) else math.nan
-        verdict = too_few(estimate.runs) or judge_value(paper, estimate, quantity("improvement"))
-        if verdict and verdict.outcome is Outcome.REPRODUCED and estimate.low <= 0:
-            verdict = Verdict(Outcome.INCONCLUSIVE, "the interval holds the paper's value and no improvement")
+        # equivalence within an absolute margin in percentage points (the config's ``tolerance_pp``): a
+        # relative margin of a 1.8 % improvement would be a hair's breadth
+        margin = spec["tolerance_pp"]
+        verdict = judge_value(paper, improvements, quantity("improvement"),
+                              tolerance=margin / abs(paper) if paper else TOLERANCE)
         row = {"method": f"{self.label(method)} vs {self.label(baseline)}", "condition": "-",
                "runs": estimate.runs, "estimate": estimate, "ours": estimate.value, "ci_low": estimate.low,
                "ci_high": estimate.high, "interval": estimate.method, "paper": paper, "verdict": verdict}
@@ -346,7 +347,7 @@ def _note(found: dict[str, Ranking], experiment: dict) -> str:
 
 class RankingTable(TableKind):
     """Methods ranked by their mean ``metric`` over the sequences, best first, with how stable that is
-    (:mod:`replication.report.ranking`): the mean over the sequences (95% percentile interval of the
+    (:mod:`replication.evidence.ranking`): the mean over the sequences (95% percentile interval of the
     two-level bootstrap), the probability of ranking first, and the mean rank with its 95% interval."""
 
     kind = "ranking"
@@ -382,14 +383,15 @@ class Pairwise(TableKind):
 
 def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
     """``metric`` of two methods run on the same data (same data condition and repetition), side by side:
-    columns ``baseline`` and ``method``, one row per shared repetition (at ``condition`` if given)."""
+    columns ``baseline``, ``method`` and ``repetition``, one row per shared repetition (at ``condition`` if
+    given)."""
     columns = ["data_condition", "repetition", metric]
     chosen = records if condition is None else records[records["condition"] == condition]
     left = chosen[chosen["method"] == baseline][columns]
     right = chosen[chosen["method"] == method][columns]
     paired = left.merge(right, on=["data_condition", "repetition"], suffixes=("_baseline", "_method"))
     return pd.DataFrame({"baseline": paired[f"{metric}_baseline"].astype(float),
-                         "method": paired[f"{metric}_method"].astype(float)})
+                         "method": paired[f"{metric}_method"].astype(float), "repetition": paired["repetition"]})
 
 
 def excess_over_floor(records: pd.DataFrame, floor_methods: list[str]) -> dict:

@@ -3,8 +3,8 @@
 :func:`code_digest` is part of every run key, so a change to any module that
 can change a run's numbers gives new runs rather than stale ones.  It hashes
 the source of every module of the package except those that never compute a run
-(:data:`READ_ONLY`: the report layer, the command line, the reader of stored records, the
-export of results for other toolkits).
+(:data:`READ_ONLY`: the evidence and report layers, the command line, the reader of stored records,
+the export of results for other toolkits).
 :func:`provenance` is written into every record, and the report shows it.
 """
 
@@ -17,10 +17,11 @@ from functools import lru_cache
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent
-# what never computes a run (prefixes of paths inside the package): the report layer, the command
-# line and its checks, the reader of stored runs and the export of results for other toolkits
-READ_ONLY = ("report/", "cli.py", "__main__.py", "scenes/__main__.py", "runner/preflight.py", "runner/results.py",
-             "export.py")
+# what never computes a run (prefixes of paths inside the package): the evidence and report layers (deciding
+# and drawing), the command line and its checks, the reader of stored runs and the export of results for
+# other toolkits
+READ_ONLY = ("evidence/", "report/", "cli.py", "__main__.py", "scenes/__main__.py", "runner/preflight.py",
+             "runner/results.py", "export.py")
 LIBRARIES = {"numpy": "numpy", "scipy": "scipy", "opencv": "opencv-python-headless", "numba": "numba"}  # column: distribution
 
 

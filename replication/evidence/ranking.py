@@ -10,15 +10,16 @@ random numbers) -- and ranks the methods by their mean over the resample.
 Over the resamples (seeded: a report is a pure function of the records):
 
 * ``P(best)``: the share of resamples in which a method ranks first;
-* ``P(rank = k)`` and the 95% percentile interval of a method's rank;
+* ``P(rank = k)`` and the mean rank (the rank's interval is :func:`rank_set`'s, from paired tests over
+  the sequences: percentiles of a bootstrap over six sequences are too narrow);
 * ``P(A beats B)``: the share in which A's mean is better than B's;
 * each method's mean over the sequences with its percentile interval (inside
   the metric's range, as every resampled mean is).
 
 The paired difference A - B of two methods is the mean over the sequences of
 their per-sequence difference (each sequence's mean over its runs), with the
-BCa interval of ``scipy.stats.bootstrap`` over the sequences
-(:func:`~replication.report.statistics.paired_difference`).
+t interval over the sequences
+(:func:`~replication.evidence.statistics.paired_difference`).
 
 Ties (equal means in a resample: two trackers that lose the target alike)
 are split evenly: tied methods share their ranks with equal probability and a
@@ -31,12 +32,16 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from replication.report.aggregate import parse_condition
-from replication.report.quantities import quantity
-from replication.report.statistics import LEVEL, RESAMPLES, SEED, Estimate, paired_difference
-from replication.report.verdict import MIN_RUNS
+from replication.evidence.quantities import quantity
+from replication.evidence.comparisons import best_test
+from replication.evidence.inference import ALPHA, holm
+from replication.evidence.statistics import LEVEL, Estimate, paired_difference
+from replication.evidence.verdict import MIN_RUNS
+from replication.evidence.aggregate import parse_condition
 
 MIN_SEQUENCES = 5  # no ranking verdict over fewer sequences: one sequence more or less can reorder them
+RESAMPLES = 2999
+SEED = 20261123  # the bootstrap's own stream: a report is a pure function of the records
 TIE = 1e-12  # means closer than this (relative to the largest score) are level: summation order, not skill
 
 
@@ -75,12 +80,12 @@ class Ranking:
         return self.methods.index(method)
 
     def rank(self, i: int) -> Estimate:
-        """Method ``i``'s mean rank and the 95% percentile interval of its rank (1 = best)."""
-        cumulative = np.cumsum(self.rank_probability[i])
-        tail = (1 - LEVEL) / 2
-        low, high = (int(np.searchsorted(cumulative, q - 1e-9)) + 1 for q in (tail, 1 - tail))
+        """Method ``i``'s mean rank over the bootstrap resamples (description) and its 95% rank set
+        (:func:`rank_set`: what the sequences show, not what the resamples of a few of them suggest)."""
+        low, high = rank_set(np.stack([self.per_sequence(j) for j in range(len(self.methods))], axis=-1), i,
+                             self.lower_is_better)
         mean = round(float(self.mean_rank[i]), 2)
-        return Estimate(mean, float(low), float(high), self.runs, "two-level bootstrap")
+        return Estimate(mean, float(low), float(high), len(self.sequences), "rank set, paired t over sequences")
 
     def score(self, i: int) -> Estimate:
         """Method ``i``'s mean over the sequences (of its mean over runs) and the percentile interval of
@@ -93,13 +98,27 @@ class Ranking:
         return self.scores[:, :, i].mean(axis=1)
 
     def difference(self, a: int, b: int) -> Estimate:
-        """Mean over the sequences of the per-sequence difference a - b, BCa interval over the sequences."""
+        """Mean over the sequences of the per-sequence difference a - b, t interval over the sequences."""
         return paired_difference(self.per_sequence(a), self.per_sequence(b))
 
     def wins(self, a: int, b: int) -> int:
         """On how many sequences a's mean over runs is better than b's."""
         ahead = self.per_sequence(a) - self.per_sequence(b)
         return int(((-ahead if self.lower_is_better else ahead) > 0).sum())
+
+
+def rank_set(per_sequence, i: int, lower_is_better: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The 95% confidence set of method ``i``'s rank (1 = best) from ``per_sequence`` (sequences x methods,
+    leading batch axes allowed): one more than the methods shown better than it, to the count of methods
+    less those shown worse, each shown by the paired t-test over the sequences, Holm across the 2 (M - 1)
+    one-sided tests (Mogstad, Romano, Shaikh and Wilhelm's marginal rank set).  The sequences are the
+    sample: a set that holds for sequences like these, not only for resamples of the few at hand."""
+    tested = best_test(per_sequence, i, lower_is_better)
+    m = np.shape(per_sequence)[-1]
+    adjusted = holm(np.concatenate([tested.p_for, tested.p_against], axis=-1))
+    shown = np.nan_to_num(adjusted, nan=1.0) < ALPHA
+    worse, better = shown[..., : m - 1].sum(axis=-1), shown[..., m - 1:].sum(axis=-1)
+    return 1 + better, m - worse
 
 
 def rank(scores: np.ndarray, methods, sequences, lower_is_better: bool) -> Ranking:

@@ -2,8 +2,8 @@
 
 import pandas as pd
 
-from replication.report.quantities import quantity
-from replication.report.statistics import estimate
+from replication.evidence.quantities import quantity
+from replication.evidence.statistics import estimate
 
 
 def parse_condition(condition: str) -> dict[str, str]:
@@ -13,7 +13,7 @@ def parse_condition(condition: str) -> dict[str, str]:
 
 def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic: str = "mean") -> pd.DataFrame:
     """One row per (method, condition): runs, the statistic, its 95% interval (``ci_low``, ``ci_high``),
-    how the interval was made, and the variance over runs.  ``scale`` converts units (100: a percentage)."""
+    how the interval was made, the variance over runs and the per-run values (``values``).  ``scale`` converts units (100: a percentage)."""
     kind = quantity(metric).scaled(scale)
     rows = []
     for (method, condition), group in records.groupby(["method", "condition"], sort=False):
@@ -28,6 +28,7 @@ def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic:
             "ci_high": found.high,
             "interval": found.method,
             "variance": float(values.var(ddof=1)) if found.runs > 1 else float("nan"),
+            "values": values.to_numpy(),
         })
     return pd.DataFrame(rows, columns=["method", "condition", "runs", "mean", "ci_low", "ci_high", "interval",
-                                       "variance"])
+                                       "variance", "values"])

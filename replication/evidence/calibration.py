@@ -1,0 +1,353 @@
+"""How often each verdict rule errs: its operating characteristics, simulated through the code that decides.
+
+Each *kind* of test draws many simulated experiments at once, at the run and
+check counts the quick and paper scales use, and passes them through the same
+functions the claims and tables call (:func:`~replication.evidence.comparisons.order_test`,
+:func:`~replication.evidence.comparisons.best_test`, the tests of
+:mod:`~replication.evidence.inference`, :func:`~replication.evidence.verdict.cell_test`,
+:func:`~replication.evidence.verdict.judge_band`, and the one rule
+:func:`~replication.evidence.verdict.decide`).  A row counts how often a verdict comes out:
+
+* ``truth = "null"``: the world in which the verdict the row ``guards`` is wrong
+  ("reproduced" guarded by no effect, or one at the edge of equivalence; "not
+  reproduced" guarded by the paper's statement being true: no effect for a sign
+  claim, the paper's own size for a sized one, the paper's value for a cell).
+  ``rate`` is the share of wrong decisive verdicts, to be at most 5 %;
+* ``truth = "effect"``: an effect of ``effect`` standard deviations in the
+  claim's favour (``guards = "reproduced"``: ``rate`` is the power) or against
+  it (``guards = "not reproduced"``).
+
+Noise, standardised to mean 0 and standard deviation 1: ``normal``, ``t3``
+(heavy tails) and ``lognormal`` (skewed, sigma = 0.5: skewness 1.75).  Two
+methods compared on common random numbers share a run's draw and add their
+own, so under the null they are interchangeable and a run's difference is
+symmetric whatever the noise; a single mean against a published number has no
+such symmetry, and at small run counts no test of a mean holds its level
+under skew (Bahadur & Savage 1956): the table shows by how much.
+
+Control rows (``control``) run the rules this project used before (a BCa
+bootstrap interval at 5 runs; any check against the claim failing it, with no
+correction; a method best when it ranked first in 95 % of bootstrap resamples,
+not best at 5 %), so the simulation is seen to catch a bad rule.
+"""
+
+import math
+import zlib
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from replication.evidence.comparisons import Effect, best_test, order_test
+from replication.evidence.inference import ALPHA, holm, mean_test, sign_test
+from replication.evidence.ranking import rank, rank_set
+from replication.evidence.robustness import depends
+from replication.evidence.verdict import OUTCOMES, Outcome, cell_test, decide, judge_band, stability_bands
+
+REPLICATIONS = 10_000  # make calibrate: a Monte Carlo standard error of at most 0.005 on every row
+QUICK_REPLICATIONS = 800  # the test suite's version
+SEED = 20261125
+DISTRIBUTIONS = ("normal", "t3", "lognormal")
+LOGNORMAL_SIGMA = 0.5
+# The paired run counts the claims' experiments use: 5 (bis_pf, ism_pf quick; hspf's runs per sequence),
+# 6 (fusion_pf quick), 10 (bis_pf paper), 20 (gps_qmcpf, hspf_ungm quick; helicopter paper), 50 (fusion_pf
+# paper), 100 (gps_qmcpf, hspf_ungm, ism_pf paper).  tests/test_calibration.py checks the list is complete.
+RUNS = (5, 6, 10, 20, 50, 100)
+CHAINS = (6, 9)  # checks in a reading: ism_pf.accuracy (2 pairs x 3 scenes), gps_qmcpf.rmse (3 x 3)
+EFFECTS = (0.5, 1.0)
+COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "rate", "mc_se", "wrong_rate",
+           "power", "holds", "control", "replications"]
+REPRODUCED, NOT_REPRODUCED = OUTCOMES.index(Outcome.REPRODUCED), OUTCOMES.index(Outcome.NOT_REPRODUCED)
+
+
+def noise(distribution: str, rng: np.random.Generator, shape) -> np.ndarray:
+    """Draws with mean 0 and standard deviation 1."""
+    if distribution == "normal":
+        return rng.standard_normal(shape)
+    if distribution == "t3":
+        return rng.standard_t(3, shape) / math.sqrt(3.0)
+    if distribution == "lognormal":
+        s2 = LOGNORMAL_SIGMA ** 2
+        return (rng.lognormal(0.0, LOGNORMAL_SIGMA, shape) - math.exp(s2 / 2)) / math.sqrt(
+            (math.exp(s2) - 1) * math.exp(s2))
+    raise ValueError(f"unknown distribution {distribution!r}; known: {DISTRIBUTIONS}")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One row to simulate: ``draw(rng, replications)`` returns each replication's verdict code."""
+
+    test: str
+    runs: int
+    checks: int
+    distribution: str
+    truth: str
+    guards: str
+    effect: float
+    draw: Callable[[np.random.Generator, int], np.ndarray]
+    control: bool = False
+
+
+def _pairs(rng, reps: int, runs: int, distribution: str, gains) -> tuple[np.ndarray, np.ndarray]:
+    """Per-run values of a claimed-better and a claimed-worse method on common random numbers (higher is
+    better), the better one ahead by ``gains`` (per check, in standard deviations of a run's difference)."""
+    gains = np.asarray(gains, dtype=float)
+    shape = (reps, *gains.shape, runs)
+    shared = noise(distribution, rng, shape)
+    worse = shared + noise(distribution, rng, shape)
+    better = shared + noise(distribution, rng, shape) + (gains * math.sqrt(2.0))[..., None]
+    return better, worse
+
+
+def _reading(p_for, p_against) -> np.ndarray:
+    return decide(p_for, p_against)[1]
+
+
+def order_case(runs, distribution, truth, guards, effect, checks=1, paper_gain=None, others=0.0) -> Case:
+    """A reading of ``checks`` paired checks: the first at ``effect``, the rest at ``others`` (an
+    intersection-union rule is at its worst with one check null and the rest strong)."""
+    def draw(rng, reps):
+        gains = [effect] + [others] * (checks - 1)
+        better, worse = _pairs(rng, reps, runs, distribution, gains)
+        paper = None if paper_gain is None else Effect(paper_gain * math.sqrt(2.0), 0.0)
+        tested = order_test(better, worse, lower_is_better=False, paper=paper)
+        return _reading(tested.p_for, tested.p_against)
+
+    name = "order" if paper_gain is None else "order, paper's size"
+    return Case(name if checks == 1 else f"{name}: reading", runs, checks, distribution, truth, guards, effect, draw)
+
+
+def ratio_case(runs, distribution, truth, guards, ratio) -> Case:
+    """A claimed ratio of means (lower is better: the paper's 0.5, ours ``ratio``): the size tested as
+    Fieller's linear form."""
+    def draw(rng, reps):
+        shared = noise(distribution, rng, (reps, runs))
+        worse = 10.0 * (1 + 0.1 * (shared + noise(distribution, rng, (reps, runs))))
+        better = ratio * 10.0 * (1 + 0.1 * (shared + noise(distribution, rng, (reps, runs))))
+        tested = order_test(better, worse, lower_is_better=True, paper=Effect(0.5, 1.0, "ratio"))
+        return _reading(tested.p_for[..., None], tested.p_against[..., None])
+
+    return Case("order, paper's ratio", runs, 1, distribution, truth, guards, ratio, draw)
+
+
+def mcnemar_case(runs, truth, guards, wins, losses, paper_gain=None) -> Case:
+    """Paired yes/no outcomes: a run is won by the claimed-better method alone with probability ``wins``,
+    lost with ``losses``, tied otherwise (``effect``: wins - losses)."""
+    def draw(rng, reps):
+        u = rng.random((reps, runs))
+        better = (u < wins).astype(float)
+        worse = ((u >= wins) & (u < wins + losses)).astype(float)
+        paper = None if paper_gain is None else Effect(paper_gain, 0.0)
+        tested = order_test(better, worse, lower_is_better=False, binary=True, paper=paper)
+        return _reading(tested.p_for[..., None], tested.p_against[..., None])
+
+    name = "order, yes/no" + ("" if paper_gain is None else ", paper's size")
+    return Case(name, runs, 1, "yes/no", truth, guards, round(wins - losses, 3), draw)
+
+
+def threshold_case(runs, distribution, truth, guards, effect) -> Case:
+    """A median against a bound (the exact sign test), the true median ``effect`` sd above it."""
+    def draw(rng, reps):
+        values = noise(distribution, rng, (reps, runs)) - _median(distribution) + effect
+        tested = sign_test(values, 0.0)
+        return _reading(tested.p_above[..., None], tested.p_below[..., None])
+
+    return Case("threshold (median)", runs, 1, distribution, truth, guards, effect, draw)
+
+
+def _median(distribution: str) -> float:
+    """The median of :func:`noise`'s draws."""
+    if distribution != "lognormal":
+        return 0.0
+    s2 = LOGNORMAL_SIGMA ** 2
+    return (1.0 - math.exp(s2 / 2)) / math.sqrt((math.exp(s2) - 1) * math.exp(s2))
+
+
+def cell_case(runs, distribution, truth, guards, mean, paper_runs=None) -> Case:
+    """A published mean of 1 against our runs of true mean ``mean`` and coefficient of variation 0.2
+    (:func:`~replication.evidence.verdict.cell_test`, the test :func:`judge_value` decides by: equivalence
+    within +-10 %)."""
+    def draw(rng, reps):
+        p_for, p_against = cell_test(1.0, mean + 0.2 * noise(distribution, rng, (reps, runs)), paper_runs=paper_runs)
+        return _reading(p_for[..., None], p_against[..., None])
+
+    return Case("published value", runs, 1, distribution, truth, guards, round((mean - 1.0) / 0.2, 3), draw)
+
+
+def band_case(runs, truth, guards, rate) -> Case:
+    """bis_pf's stability rating ('good': at most 1.5 failures in 10) against runs failing at ``rate``."""
+    bands = stability_bands()
+
+    def draw(rng, reps):
+        failures = rng.binomial(runs, rate, reps)
+        return np.array([OUTCOMES.index(judge_band("good", int(k), runs, bands).outcome) for k in failures])
+
+    return Case("rating (band)", runs, 1, "yes/no", truth, guards, rate, draw)
+
+
+def _cube(rng, reps, distribution, lead, methods=7, sequences=6, runs=5, spread=0.1):
+    """Scores (reps x sequences x runs x methods, higher is better) of methods that differ per sequence
+    (sd ``spread``) and per run (sd ``spread``, common random numbers), method 0 ahead of the rest by
+    ``lead`` (the rest level)."""
+    per_sequence = spread * noise(distribution, rng, (reps, sequences, 1, methods))
+    shared = spread * noise(distribution, rng, (reps, sequences, runs, 1))
+    own = spread * noise(distribution, rng, (reps, sequences, runs, methods))
+    scores = per_sequence + shared + own
+    scores[..., 0] += lead
+    return scores
+
+
+def best_case(distribution, truth, guards, lead, control=False) -> Case:
+    """'Method 0 is best' over 7 methods x 6 sequences x 5 runs (hspf at paper scale), method 0 ahead of
+    the others by ``lead`` (in sd of a sequence's difference, sqrt(2) x 0.1 x sqrt(1 + 1/5))."""
+    unit = 0.1 * math.sqrt(2.0 * (1 + 1 / 5))
+
+    def draw(rng, reps):
+        scores = _cube(rng, reps, distribution, lead * unit)
+        if control:
+            return np.array([_old_best(s) for s in scores])
+        tested = best_test(scores.mean(axis=2), 0, lower_is_better=False)
+        return _reading(tested.p_for, tested.p_against)
+
+    name = "best (P(best), old rule)" if control else "best"
+    return Case(name, 5, 6, distribution, truth, guards, lead, draw, control)
+
+
+def _old_best(scores: np.ndarray) -> int:
+    found = rank(scores, list(range(scores.shape[-1])), list(range(scores.shape[0])), lower_is_better=False)
+    p = float(found.p_best[found.methods.index(0)])
+    return REPRODUCED if p >= 0.95 else NOT_REPRODUCED if p <= 0.05 else OUTCOMES.index(Outcome.INCONCLUSIVE)
+
+
+def rank_case(distribution, control=False) -> Case:
+    """A rank interval's coverage: 7 methods 0.2 sd apart (true ranks distinct but close) over 6 sequences x
+    5 runs, each sequence favouring each method by its own draw; a replication errs where the middle
+    method's interval misses its true rank, 4."""
+    unit = 0.1 * math.sqrt(2.0 * (1 + 1 / 5))
+
+    def draw(rng, reps):
+        scores = _cube(rng, reps, distribution, 0.0)
+        scores += unit * 0.2 * np.arange(7)[::-1]  # method 0 best, true rank k + 1
+        if control:
+            found = [rank(s, list(range(7)), list(range(6)), lower_is_better=False) for s in scores]
+            low, high = np.array([_percentile_rank(f, 3) for f in found]).T
+        else:
+            low, high = rank_set(scores.mean(axis=2), 3, lower_is_better=False)
+        return np.where((low <= 4) & (4 <= high), REPRODUCED, NOT_REPRODUCED)
+
+    name = "rank interval (bootstrap percentiles, old rule)" if control else "rank interval (rank set)"
+    return Case(name, 5, 6, distribution, "null", "misses the true rank", 0.2, draw, control)
+
+
+def _percentile_rank(found, method: int) -> tuple[int, int]:
+    """The old rank interval: the 2.5 and 97.5 percentiles of the two-level bootstrap's rank distribution."""
+    cumulative = np.cumsum(found.rank_probability[found.methods.index(method)])
+    return tuple(int(np.searchsorted(cumulative, q - 1e-9)) + 1 for q in (0.025, 0.975))
+
+
+def bca_case(runs, distribution, truth, guards, checks, effect) -> Case:
+    """The rule of before: each check's 95 % BCa interval of the paired mean; reproduced when every interval
+    lies above zero, not reproduced when any lies at or below it (no correction)."""
+    def draw(rng, reps):
+        codes = []
+        for chunk in np.array_split(np.arange(reps), max(1, reps * checks * runs // 20_000)):
+            better, worse = _pairs(rng, len(chunk), runs, distribution, [effect] * checks)
+            interval = stats.bootstrap((better - worse,), np.mean, axis=-1, vectorized=True, method="BCa",
+                                       n_resamples=999, random_state=rng).confidence_interval
+            low, high = np.nan_to_num(interval.low, nan=-np.inf), np.nan_to_num(interval.high, nan=np.inf)
+            codes.append(np.select([(high <= 0).any(axis=-1), (low > 0).all(axis=-1)], [NOT_REPRODUCED, REPRODUCED],
+                                   2))
+        return np.concatenate(codes)
+
+    name = "order (BCa, old rule)" if checks == 1 else "order: reading (BCa, any check fails, old rule)"
+    return Case(name, runs, checks, distribution, truth, guards, effect, draw, control=True)
+
+
+def robustness_case(runs, distribution, truth, guards, effect, alternatives=4) -> Case:
+    """A claim's multiverse: a default universe and ``alternatives`` others on the same data (each adds its
+    own noise, half the runs' own, and ``effect`` sd to the deciding paired difference; the default sits at
+    0.5 sd, where verdicts of few runs flip often); the verdict depends on the reading where an alternative
+    moves it (:func:`~replication.evidence.robustness.depends`).  Under no effect "depends on the reading"
+    is wrong; under an effect of -1 sd (the choice turns the claim's 0.5 sd gain into -0.5) it is right."""
+    def draw(rng, reps):
+        better, worse = _pairs(rng, reps, runs, distribution, [0.5])  # the default universe, reps x 1 x runs
+        moved = better + 0.5 * noise(distribution, rng, (reps, alternatives, runs)) + effect * math.sqrt(2.0)
+        default, other = (order_test(b, worse, lower_is_better=False) for b in (better, moved))
+        flipped = _reading(other.p_for[..., None], other.p_against[..., None]) != \
+            _reading(default.p_for[..., None], default.p_against[..., None])
+        shift = mean_test(moved - better)  # each alternative's paired effect on the deciding statistic
+        adjusted = holm(np.minimum(1.0, 2 * np.minimum(shift.p_above, shift.p_below)))
+        return np.where(depends(adjusted, flipped).any(axis=-1), NOT_REPRODUCED, REPRODUCED)
+
+    return Case("multiverse robustness", runs, alternatives, distribution, truth, guards, effect, draw)
+
+
+def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
+    """Every row of the calibration table."""
+    found = []
+    for n in runs:
+        for d in distributions:
+            found += [order_case(n, d, "null", "reproduced", 0.0), order_case(n, d, "null", "not reproduced", 0.0)]
+            found += [order_case(n, d, "effect", "reproduced", e) for e in EFFECTS]
+            found += [order_case(n, d, "null", "not reproduced", 1.0, paper_gain=1.0),
+                      order_case(n, d, "effect", "not reproduced", 0.0, paper_gain=1.0)]
+            found += [ratio_case(n, d, "null", "not reproduced", 0.5), ratio_case(n, d, "effect", "not reproduced",
+                                                                                   1.0)]
+            found += [threshold_case(n, d, "null", "reproduced", 0.0), threshold_case(n, d, "null", "not reproduced",
+                                                                                      0.0)]
+            found += [threshold_case(n, d, "effect", "reproduced", e) for e in EFFECTS]
+            found += [cell_case(n, d, "null", "reproduced", 1.1), cell_case(n, d, "null", "not reproduced", 1.0),
+                      cell_case(n, d, "effect", "reproduced", 1.0)]
+            found += [cell_case(n, d, "effect", "not reproduced", 1.0 + 0.2 * e) for e in EFFECTS]
+            for k in CHAINS:
+                found += [order_case(n, d, "null", "reproduced", 0.0, checks=k, others=3.0),
+                          order_case(n, d, "null", "not reproduced", 0.0, checks=k),
+                          order_case(n, d, "null", "not reproduced", 1.0, checks=k, paper_gain=1.0, others=1.0),
+                          order_case(n, d, "effect", "reproduced", 1.0, checks=k, others=1.0)]
+        found += [robustness_case(n, d, "null", "depends on the reading", 0.0) for d in distributions]
+        found += [robustness_case(n, d, "effect", "depends on the reading", -1.0) for d in distributions]
+        found += [mcnemar_case(n, "null", "reproduced", 0.2, 0.2), mcnemar_case(n, "null", "not reproduced", 0.2, 0.2),
+                  mcnemar_case(n, "effect", "reproduced", 0.5, 0.0),
+                  mcnemar_case(n, "null", "not reproduced", 0.45, 0.05, paper_gain=0.4),
+                  mcnemar_case(n, "effect", "not reproduced", 0.1, 0.1, paper_gain=0.4)]
+    for n in (5, 10):
+        found += [band_case(n, "null", "not reproduced", 0.15), band_case(n, "null", "reproduced", 0.16)]
+    for d in distributions:
+        found += [best_case(d, "null", "reproduced", 0.0), best_case(d, "null", "not reproduced", 0.0),
+                  best_case(d, "effect", "reproduced", 1.0)]
+    found += [rank_case(d) for d in distributions] + [rank_case("normal", control=True)]
+    for n in (5, 20):
+        found += [bca_case(n, d, "null", "reproduced", 1, 0.0) for d in distributions]
+        found += [bca_case(n, d, "null", "not reproduced", 9, 0.0) for d in distributions]
+    found += [best_case("normal", "null", "not reproduced", 0.14, control=True)]
+    return found
+
+
+def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
+    """One row: the share of replications giving the verdict the case guards, with its Monte Carlo error."""
+    name = repr((case.test, case.runs, case.checks, case.distribution, case.truth, case.guards, case.effect))
+    rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
+    codes = case.draw(rng, replications)
+    guarded = REPRODUCED if case.guards in ("reproduced", "robust") else NOT_REPRODUCED  # or "depends", "misses"
+    rate = float(np.mean(codes == guarded))
+    mc_se = math.sqrt(max(rate * (1 - rate), 1e-12) / replications)
+    null = case.truth == "null"
+    return {"test": case.test, "runs": case.runs, "checks": case.checks, "distribution": case.distribution,
+            "truth": case.truth, "guards": case.guards, "effect": case.effect, "rate": rate, "mc_se": mc_se,
+            "wrong_rate": rate if null else float(np.mean(codes == (NOT_REPRODUCED if guarded == REPRODUCED
+                                                                     else REPRODUCED))),
+            "power": math.nan if null else rate, "holds": (rate <= ALPHA + 2 * mc_se) if null else None,
+            "control": case.control, "replications": replications}
+
+
+def calibrate(replications: int = REPLICATIONS, runs=RUNS, distributions=DISTRIBUTIONS, progress=None) -> pd.DataFrame:
+    """The calibration table (``reports/calibration.csv``): one row per case of :func:`cases`."""
+    rows = []
+    todo = cases(runs, distributions)
+    for i, case in enumerate(todo):
+        rows.append(simulate(case, replications))
+        if progress:
+            progress(i + 1, len(todo))
+    return pd.DataFrame(rows, columns=COLUMNS)

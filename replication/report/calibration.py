@@ -1,0 +1,152 @@
+"""``reports/calibration.csv`` and ``reports/calibration/index.html``: how often each verdict rule errs.
+
+The table is :func:`replication.evidence.calibration.calibrate`'s: every rule
+simulated through the code that decides, under normal, heavy-tailed and skewed
+noise, at the run and check counts the scales use.  It takes minutes, so it is
+kept beside a note of the code and replications that made it
+(``calibration.json``) and made again only when a file of
+``replication/evidence/`` changes or more replications are asked for:
+``make replicate`` reuses it.
+
+    python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]
+"""
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+from omegaconf import OmegaConf  # noqa: E402
+from tqdm.auto import tqdm  # noqa: E402
+
+from replication.evidence import calibration  # noqa: E402
+from replication.evidence.inference import ALPHA, detectable  # noqa: E402
+from replication.paths import CONF_DIR, PACKAGE_DIR, resolve  # noqa: E402
+from replication.report.render import html_table, render  # noqa: E402
+
+CSV = "calibration.csv"
+NOTE = "calibration.json"
+
+
+def evidence_digest() -> str:
+    """SHA-256 (12 hex digits) of the deciding code: what the calibration simulates."""
+    digest = hashlib.sha256()
+    for path in sorted((PACKAGE_DIR / "evidence").glob("*.py")):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:12]
+
+
+def load_or_calibrate(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> pd.DataFrame:
+    """The stored table when the deciding code and replications are those that made it, else a new one."""
+    csv, note = reports / CSV, reports / NOTE
+    wanted = {"evidence": evidence_digest(), "replications": replications, "seed": calibration.SEED}
+    if not force and csv.exists() and note.exists() and json.loads(note.read_text()) == wanted:
+        return read(csv)
+    with tqdm(total=len(calibration.cases()), desc="calibration", unit="rule") as bar:
+        table = calibration.calibrate(replications, progress=lambda done, total: bar.update(1))
+    reports.mkdir(parents=True, exist_ok=True)
+    table.to_csv(csv, index=False)
+    note.write_text(json.dumps(wanted, indent=1))
+    return table
+
+
+def read(path: Path) -> pd.DataFrame:
+    """The table back from its CSV ('null' is a truth, not a missing value)."""
+    return pd.read_csv(path, keep_default_na=False, na_values=[""])
+
+
+def failures(table: pd.DataFrame, standard_errors: float = 2.0) -> pd.DataFrame:
+    """The rows of the project's rules (not the controls) whose null rate exceeds 5 % by more than
+    ``standard_errors`` Monte Carlo standard errors."""
+    null = table[(table["truth"] == "null") & ~table["control"].astype(bool)]
+    return null[null["rate"] > ALPHA + standard_errors * null["mc_se"]]
+
+
+def draw_null_rates(table: pd.DataFrame, path: Path) -> None:
+    """Each null row's rate of wrong decisive verdicts with 2 Monte Carlo standard errors, by test kind and
+    run count; the old rules (controls) in red; 5 % dashed."""
+    null = table[table["truth"] == "null"].copy()
+    null["row"] = null["test"] + " | " + null["guards"]
+    rows = list(dict.fromkeys(null.sort_values(["control", "test"])["row"]))
+    fig, ax = plt.subplots(figsize=(9, 0.35 * len(rows) + 1.2))
+    markers = {"normal": "o", "t3": "^", "lognormal": "s", "yes/no": "D"}
+    for y, row in enumerate(rows):
+        for _, r in null[null["row"] == row].iterrows():
+            colour = "tab:red" if r["control"] else plt.cm.viridis(np.log(r["runs"]) / np.log(120))
+            ax.errorbar(r["rate"], y + (np.log(r["runs"]) / np.log(120) - 0.5) * 0.6, xerr=2 * r["mc_se"],
+                        fmt=markers.get(r["distribution"], "o"), color=colour, ms=3, lw=0.6)
+    ax.axvline(ALPHA, color="0.3", ls="--", lw=1)
+    ax.set_yticks(range(len(rows)), rows, fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xlabel("share of wrong decisive verdicts under the null (2 Monte Carlo SE)")
+    handles = [plt.Line2D([], [], marker=m, color="0.4", ls="", label=d) for d, m in markers.items()]
+    handles += [plt.Line2D([], [], marker="o", color="tab:red", ls="", label="old rule (control)")]
+    ax.legend(handles=handles, fontsize=7, loc="lower right")
+    ax.set_title("Error rates under the null (colour: run count, 5 to 100)", fontsize=9, loc="left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, bbox_inches="tight")  # the rules' names are long
+    plt.close(fig)
+
+
+def draw_power(table: pd.DataFrame, path: Path) -> None:
+    """The operating characteristic of a single paired check and of the median's sign test: the share
+    reproduced against the run count, at no effect and at effects of 0.5 and 1 standard deviation."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharey=True)
+    for ax, test in zip(axes, ["order", "threshold (median)"]):
+        chosen = table[(table["test"] == test) & (table["guards"] == "reproduced")]
+        for (distribution, effect), rows in chosen.groupby(["distribution", "effect"]):
+            rows = rows.sort_values("runs")
+            ax.plot(rows["runs"], rows["rate"], marker="o", ms=3,
+                    ls={"normal": "-", "t3": "--", "lognormal": ":"}[distribution],
+                    color={0.0: "tab:red", 0.5: "tab:orange", 1.0: "tab:green"}[effect],
+                    label=f"{effect:g} sd, {distribution}")
+        ax.axhline(ALPHA, color="0.3", ls="--", lw=0.8)
+        ax.axhline(0.8, color="0.6", ls=":", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_xlabel("runs")
+        ax.set_title(test, fontsize=9, loc="left")
+    axes[0].set_ylabel("share reproduced")
+    axes[1].legend(fontsize=6, ncol=1, loc="center right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, bbox_inches="tight")  # the rules' names are long
+    plt.close(fig)
+
+
+def write_calibration(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> Path:
+    """The calibration page (and its table, made only when stale)."""
+    table = load_or_calibrate(reports, replications, force)
+    out = reports / "calibration"
+    out.mkdir(parents=True, exist_ok=True)
+    draw_null_rates(table, out / "null_rates.png")
+    draw_power(table, out / "power.png")
+    shown = table.drop(columns=["holds", "replications"]).round({"rate": 4, "mc_se": 4, "wrong_rate": 4,
+                                                                   "power": 4})
+    page = out / "index.html"
+    page.write_text(render(
+        "calibration.html.j2", title="How often the verdict rules err: calibration", module=calibration.__doc__,
+        failed=failures(table), table=html_table(shown), replications=int(table["replications"].max()),
+        rows=len(table), floor=2.0 ** -5, detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
+    return page
+
+
+def main(argv: list[str]) -> None:
+    options = dict(a.split("=", 1) for a in argv if "=" in a)
+    unknown = set(options) - {"reports", "replications", "force"}
+    if unknown or len(options) != len(argv):
+        print("usage: python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]",
+              file=sys.stderr)
+        raise SystemExit(2)
+    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
+    page = write_calibration(reports, int(options.get("replications", calibration.REPLICATIONS)),
+                             options.get("force", "false").lower() == "true")
+    print(f"calibration: {page}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

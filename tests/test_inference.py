@@ -1,0 +1,127 @@
+"""The tests behind the verdicts against scipy's own, hand cases and simulation of their level."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from replication.evidence.comparisons import Effect, best_test, order_test
+from replication.evidence.inference import (
+    ALPHA, clopper_pearson, detectable, holm, mean_test, paired_binary_test, proportion_test, sign_test,
+)
+from replication.evidence.verdict import OUTCOMES, Outcome, decide
+
+RNG = np.random.default_rng(7)
+
+
+def test_mean_test_is_scipys_one_sample_t_test_with_its_90_percent_interval():
+    values = RNG.normal(1.0, 2.0, 9)
+    found = mean_test(values, 0.5)
+    scipy = stats.ttest_1samp(values, 0.5, alternative="greater")
+    assert found.p_above == pytest.approx(scipy.pvalue)
+    assert found.p_below == pytest.approx(stats.ttest_1samp(values, 0.5, alternative="less").pvalue)
+    interval = stats.ttest_1samp(values, 0.5).confidence_interval(1 - 2 * ALPHA)
+    assert (found.low, found.high) == pytest.approx((interval.low, interval.high))
+
+
+def test_mean_test_works_on_a_batch_and_refuses_runs_that_all_agree():
+    batch = RNG.normal(size=(4, 3, 6))
+    found = mean_test(batch)
+    assert found.p_above.shape == (4, 3)
+    assert found.p_above[2, 1] == pytest.approx(stats.ttest_1samp(batch[2, 1], 0, alternative="greater").pvalue)
+    tied = mean_test([2.0, 2.0, 2.0, 2.0, 2.0])
+    assert not tied.defined and math.isnan(tied.low)  # no zero-width interval, no verdict
+
+
+def test_sign_test_is_the_exact_binomial_test_and_its_floor_at_5_runs_is_1_32():
+    values = np.array([0.3, 1.2, 2.0, -0.1, 0.8, 0.0, 1.5])  # the tie with the reference is dropped
+    found = sign_test(values)
+    assert found.p_above == pytest.approx(stats.binomtest(5, 6, 0.5, alternative="greater").pvalue)
+    assert sign_test([1.0, 2.0, 3.0, 4.0, 5.0]).p_above == pytest.approx(1 / 32)
+    five = sign_test([5.0, 1.0, 4.0, 2.0, 3.0])
+    assert (five.low, five.high) == (1.0, 5.0)  # P(min < median < max) = 30/32 >= 90%
+    assert math.isnan(sign_test([1.0, 2.0, 3.0, 4.0]).low)  # 4 runs: 14/16 < 90%: no interval
+
+
+def test_mcnemar_is_the_sign_test_on_the_discordant_pairs():
+    ours = np.array([1, 1, 1, 0, 1, 1, 0, 1, 1, 1])
+    theirs = np.array([0, 0, 1, 0, 0, 1, 1, 0, 0, 1])
+    found = paired_binary_test(ours - theirs)  # 5 pairs only ours got right, 1 only theirs
+    assert found.p_above == pytest.approx(stats.binomtest(5, 6, 0.5, alternative="greater").pvalue)
+    assert found.low <= 0.4 <= found.high and -1 <= found.low and found.high <= 1
+
+
+@pytest.mark.parametrize("k, n", [(0, 5), (3, 10), (10, 10), (37, 100)])
+def test_clopper_pearson_is_scipys_exact_interval(k, n):
+    scipy = stats.binomtest(k, n).proportion_ci(0.95, method="exact")
+    assert clopper_pearson(k, n, 0.95) == pytest.approx((scipy.low, scipy.high))
+
+
+def test_proportion_test_is_the_exact_binomial_test():
+    found = proportion_test(17, 20, 0.6)
+    assert found.p_above == pytest.approx(stats.binomtest(17, 20, 0.6, alternative="greater").pvalue)
+    assert found.p_below == pytest.approx(stats.binomtest(17, 20, 0.6, alternative="less").pvalue)
+
+
+def test_holm_by_hand():
+    # sorted 0.01, 0.03, 0.04: x3, x2, x1 = 0.03, 0.06, 0.04 -> running max 0.03, 0.06, 0.06
+    assert holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
+    adjusted = holm([0.02, np.nan, 0.5])  # NaN: not in the family, which is then of two
+    assert adjusted[0] == pytest.approx(0.04) and np.isnan(adjusted[1]) and adjusted[2] == pytest.approx(0.5)
+    np.testing.assert_allclose(holm([[0.01, 0.2], [0.9, 0.001]]), [[0.02, 0.2], [0.9, 0.002]])
+
+
+def test_detectable_effect_has_80_percent_power():
+    runs = 12
+    effect = detectable(1.0, runs)
+    found = mean_test(RNG.normal(effect, 1.0, (20_000, runs)))
+    assert np.mean(found.p_above < ALPHA) == pytest.approx(0.8, abs=0.02)
+
+
+def test_decide_by_hand():
+    reproduced, not_reproduced, inconclusive, not_testable = (OUTCOMES.index(o) for o in Outcome)
+    codes, reading, _ = decide([0.01, 0.02], [0.9, 0.8])
+    assert list(codes) == [reproduced] * 2 and reading == reproduced  # every check holds
+    codes, reading, _ = decide([0.01, 0.5], [0.9, 0.3])
+    assert list(codes) == [reproduced, inconclusive] and reading == inconclusive
+    codes, reading, adjusted = decide([0.9, 0.9, 0.9], [0.04, 0.5, 0.6])  # 0.04 x 3 > 5 %: Holm undoes it
+    assert reading == inconclusive and adjusted[0] == pytest.approx(0.12)
+    codes, reading, _ = decide([0.9, 0.01], [0.001, 0.9])
+    assert list(codes) == [not_reproduced, reproduced] and reading == not_reproduced
+    codes, reading, _ = decide([np.nan, 0.01], [np.nan, 0.9])  # a check that is not testable takes no part
+    assert list(codes) == [not_testable, reproduced] and reading == reproduced
+    assert decide([np.nan], [np.nan])[1] == not_testable
+
+
+def test_order_test_orients_the_gain_and_tests_the_papers_difference():
+    worse = np.array([4.2, 4.0, 4.5, 4.1, 4.3, 4.4])
+    better = worse - np.array([0.1, 0.12, 0.08, 0.11, 0.09, 0.1])  # lower is better: better by about 0.1
+    found = order_test(better, worse, lower_is_better=True)
+    assert found.p_for < 1e-4 and found.gain.value == pytest.approx(0.1)
+    sized = order_test(better, worse, lower_is_better=True, paper=Effect(1.6, 4.2))  # the paper's gain: 2.6
+    assert sized.p_against < 1e-4 and sized.p_for < 1e-4  # the sign agrees, the size does not
+    close = order_test(better, worse, lower_is_better=True, paper=Effect(4.1, 4.2))  # the paper's gain: 0.1
+    assert close.p_against > 0.3
+
+
+def test_a_ratio_is_tested_in_fiellers_linear_form():
+    worse = np.array([10.0, 11.0, 9.0, 10.5, 9.5, 10.2, 9.8, 10.1])
+    better = 0.5 * worse + np.array([0.1, -0.1, 0.05, -0.05, 0.0, 0.1, -0.1, 0.0])
+    assert order_test(better, worse, True, paper=Effect(0.91, 2.72, "ratio")).p_against < 1e-4  # 0.33 absent
+    assert order_test(better, worse, True, paper=Effect(1.0, 2.0, "ratio")).p_against > 0.1  # 0.5: consistent
+
+
+def test_a_yes_no_size_is_bounded_by_the_runs_only_the_better_method_got_right():
+    better, worse = np.zeros(100), np.zeros(100)  # every pair ties: no direction to test
+    found = order_test(better, worse, False, binary=True, paper=Effect(0.95, 0.55))
+    assert np.isnan(found.p_for) and found.p_against == pytest.approx(stats.binom.cdf(0, 100, 0.4))
+
+
+def test_best_test_pairs_each_competitor_over_the_sequences():
+    per_sequence = np.array([[0.9, 0.5, 0.6], [0.8, 0.6, 0.7], [0.95, 0.4, 0.5], [0.7, 0.5, 0.65],
+                             [0.85, 0.55, 0.6]])  # sequences x methods, higher is better
+    found = best_test(per_sequence, 0, lower_is_better=False)
+    assert found.p_for.shape == (2,)
+    expected = stats.ttest_rel(per_sequence[:, 0], per_sequence[:, 2], alternative="greater").pvalue
+    assert found.p_for[1] == pytest.approx(expected)

@@ -1,0 +1,45 @@
+"""The deciding layer looks only down: replication/evidence/ imports numpy, scipy and pandas, never the
+report, the runner, matplotlib or Jinja (read from the source with ast, so nothing is imported)."""
+
+import ast
+
+from replication.paths import PACKAGE_DIR
+
+FORBIDDEN = ("replication.report", "replication.runner", "replication.cli", "matplotlib", "jinja2", "omegaconf",
+             "hydra")
+
+
+def _imports(path) -> set[str]:
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            found.add(node.module)
+    return found
+
+
+def test_evidence_imports_nothing_above_it():
+    files = sorted((PACKAGE_DIR / "evidence").glob("*.py"))
+    assert len(files) >= 8
+    for path in files:
+        upward = {name for name in _imports(path) if name.startswith(FORBIDDEN)}
+        assert not upward, (path.name, upward)
+
+
+def test_editing_the_deciding_or_drawing_code_keeps_every_run_key(tmp_path):
+    """A change of a verdict rule computes no run anew; a change of a filter does."""
+    import shutil
+
+    from replication.runner.provenance import code_digest as cached
+
+    code_digest = cached.__wrapped__  # uncached: the same folder is hashed after each edit
+
+    package = tmp_path / "replication"
+    shutil.copytree(PACKAGE_DIR, package, ignore=shutil.ignore_patterns("__pycache__", "conf"))
+    before = code_digest(package)
+    for edited in ("evidence/verdict.py", "report/tables.py"):
+        (package / edited).write_text((package / edited).read_text() + "\n# a new rule\n")
+        assert code_digest(package) == before, edited
+    (package / "filters/bootstrap.py").write_text((package / "filters/bootstrap.py").read_text() + "\n# x\n")
+    assert code_digest(package) != before
