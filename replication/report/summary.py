@@ -11,6 +11,7 @@ replicated at all.
 """
 
 import json
+from collections import Counter
 import sys
 from pathlib import Path
 
@@ -109,13 +110,26 @@ def summary_table(
     return pd.DataFrame(rows, columns=columns)
 
 
-def counts(table: pd.DataFrame) -> dict:
-    """How many cells were compared, with which outcomes, and why the others were not (first words)."""
+def counts(table: pd.DataFrame, summaries: dict[str, dict] | None = None) -> dict:
+    """How many cells were compared, with which outcomes, and why the others were not (first words); with
+    ``summaries``, also the outcomes of the numbers judged within a tolerance, as configured and at each
+    other tolerance (``sensitivity``: {'as configured' or '+-5%': {outcome: count}})."""
     compared = table[table["verdict"] != ""]
     verdicts = compared["outcome"].value_counts()
     reasons = table[table["reason"] != ""]["reason"].map(lambda r: r.split(":")[0]).value_counts()
+    moved, seen = {}, set()
+    for summary in (summaries or {}).values():  # the first entry of each cell, as summary_table shows it
+        for entry in summary.get("cells", []):
+            if entry["published_index"] in seen:
+                continue
+            seen.add(entry["published_index"])
+            if entry.get("at_tolerance"):
+                moved.setdefault("as configured", Counter())[entry["verdict"]["outcome"]] += 1
+            for tolerance, outcome in entry.get("at_tolerance", {}).items():
+                moved.setdefault(f"+-{float(tolerance):.0%}", Counter())[outcome] += 1
     return {"cells": len(table), "compared": len(compared), "verdicts": dict(verdicts.items()),
-            "reasons": dict(reasons.items())}
+            "reasons": dict(reasons.items()),
+            "sensitivity": {t: dict(c) for t, c in moved.items()}}
 
 
 def _verdict(entry: dict) -> tuple[str, str]:

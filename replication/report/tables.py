@@ -28,6 +28,9 @@ from replication.report.published import cells
 from replication.evidence.ranking import Ranking, rankings, unreliable
 
 FLOOR_FILTER = "point_mass"
+# the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
+# these, so the index shows how far the cells' verdicts move with it
+SENSITIVITY = (0.05, 0.20)
 KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
 
 
@@ -192,9 +195,11 @@ class Comparison(TableKind):
             estimate = Estimate(row["mean"], row["ci_low"], row["ci_high"], row["runs"], row["interval"])
             hit = match(theirs, row["method"], row["condition"], spec)
             paper = float(hit["number"].iloc[0]) if len(hit) else math.nan
-            verdict = judge_value(paper, row["values"], kind,
-                                  spec.get("statistic", "mean"), spec.get("paper_runs"), floor_runs,
-                                  spec.get("tolerance", TOLERANCE))
+            def judged(tolerance: float) -> Verdict | None:
+                return judge_value(paper, row["values"], kind, spec.get("statistic", "mean"), spec.get("paper_runs"),
+                                   floor_runs, tolerance)
+
+            verdict = judged(spec.get("tolerance", TOLERANCE))
             shown = {"method": self.label(row["method"]), "condition": row["condition"] or "-",
                      "runs": row["runs"], "estimate": estimate, "ours": row["mean"], "ci_low": row["ci_low"],
                      "ci_high": row["ci_high"], "interval": row["interval"]}
@@ -205,7 +210,8 @@ class Comparison(TableKind):
                 shown["variance over runs"] = row["variance"]
             shown.update(paper=paper, verdict=verdict)
             rows.append(shown)
-            entries += [self.entry(i, shown, verdict, estimate) for i in hit.index]
+            moved = {f"{t:g}": judged(t).outcome.value for t in SENSITIVITY} if verdict else {}
+            entries += [{**self.entry(i, shown, verdict, estimate), "at_tolerance": moved} for i in hit.index]
         return Table(pd.DataFrame(rows), entries)
 
 
