@@ -152,7 +152,8 @@ def run_experiment(cfg: DictConfig) -> None:
         from replication.report.index import write_index
 
         written = write_experiment_report(cfg, runs, store)
-        print(f"{cfg.experiment.name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
+        index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
+        print(f"{cfg.experiment.name}: report in {written}; index in {index}")
         run_companions(cfg)
         exit_if_failed(store, runs)
     except BackendError as error:
@@ -188,7 +189,8 @@ def run_multiverse(cfg: DictConfig) -> None:
         from replication.report.multiverse import write_multiverse_report
 
         written = write_multiverse_report(cfg, multiverse)
-        print(f"{name}: report in {written}; index in {write_index(resolve(cfg.reports))}")
+        index = write_index(resolve(cfg.reports), cfg.published_values)
+        print(f"{name}: report in {written}; index in {index}")
     except BackendError as error:
         fail(str(error))
     except KeyboardInterrupt:

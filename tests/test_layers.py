@@ -43,3 +43,18 @@ def test_editing_the_deciding_or_drawing_code_keeps_every_run_key(tmp_path):
         assert code_digest(package) == before, edited
     (package / "filters/bootstrap.py").write_text((package / "filters/bootstrap.py").read_text() + "\n# x\n")
     assert code_digest(package) != before
+
+
+def test_one_report_judges_against_one_published_values_file(tmp_path):
+    """The index and the figures take the file the report was given; nothing reloads the default."""
+    import pandas as pd
+
+    from replication.report.index import write_index
+
+    assert "replication.report.index" not in _imports(PACKAGE_DIR / "report" / "figures.py")
+    own = tmp_path / "mine.csv"
+    own.write_text("paper,table,experiment,method,metric,condition,value,unit,note\n"
+                   "gps_qmcpf,1,ungm,PF,rmse,N=500,9.99,,a number of my own\n")
+    write_index(tmp_path / "reports", own)
+    summary = pd.read_csv(tmp_path / "reports" / "summary.csv", keep_default_na=False, dtype=str)
+    assert list(summary["paper_value"]) == ["9.99"] and list(summary["note"]) == ["a number of my own"]

@@ -52,7 +52,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
             try:
-                draw(records, figure_spec, experiment, out / file)
+                draw(records, figure_spec, experiment, out / file, published)
             except NothingToDraw:  # as a table none of whose conditions ran: left out
                 continue
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too

@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from replication.evidence.aggregate import parse_condition, summarise  # noqa: E402
-from replication.report.published import cells, load_published  # noqa: E402
+from replication.report.published import COLUMNS, cells  # noqa: E402
 from replication.report.style import (  # noqa: E402
     BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
     shades,
@@ -223,8 +223,8 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
          published: pd.DataFrame | None = None) -> Path:
     """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
 
-    A spec that names a ``paper_table`` gets the published values: ``published``,
-    else those of ``conf/config.yaml``'s ``published_values`` (none if that file is missing).
+    A spec that names a ``paper_table`` gets the published values ``published``: the file the report was
+    asked to judge against, passed down once (none: no paper values on the figure).
     A spec with ``conditions: [..]`` draws the runs of those conditions only.
     """
     figures = _figures()
@@ -237,7 +237,5 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
     if "paper_table" not in spec:
         return figures[spec["kind"]](records, spec, experiment, path)
     if published is None:
-        from replication.report.index import default_published_values
-
-        published = load_published(str(default_published_values()))
+        published = pd.DataFrame(columns=COLUMNS + ["number"])
     return figures[spec["kind"]](records, spec, experiment, path, published=published)
