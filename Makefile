@@ -1,5 +1,6 @@
 # make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html and reports/replication.pdf
 # make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
+# make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine (reports/benchmark/)
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
@@ -21,7 +22,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-all replicate readings report benchmark docs calibrate
+.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate
 
 setup: $(VENV)/.installed
 
@@ -44,6 +45,9 @@ browser:
 
 test: setup browser
 	$(BIN)/python -m pytest -m "not slow"
+
+test-fast: setup
+	$(BIN)/python -m pytest -m "not slow and not e2e"
 
 test-all: setup browser
 	$(BIN)/python -m pytest

@@ -183,6 +183,7 @@ def test_the_intact_copy_passes(tmp_path):
     assert np.isfinite(sequence.truth).all()
 
 
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 def test_a_users_own_sequences_run_through_an_experiment(tmp_path):
     """``data.otb=<folder> sequences=[...]``: the experiment's methods on the user's sequences alone."""
     girl = girl_copy(tmp_path)

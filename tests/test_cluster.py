@@ -24,6 +24,9 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
     return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
 
 
+pytestmark = pytest.mark.e2e  # clusters and subprocesses: make test-fast leaves them out
+
+
 @pytest.fixture(scope="module")
 def cluster():
     distributed = pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")

@@ -123,6 +123,7 @@ def assert_all_end(pids: set[int], within: float = 5.0) -> None:
 NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table in /proc")
 
 
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 @NEEDS_PROC
 def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg, tmp_path):
     """Ctrl-C at one random moment, SIGTERM at another, SIGKILL at a third, resume: the table of an
@@ -190,6 +191,7 @@ def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(m
     pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
 
 
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 @NEEDS_PROC
 @pytest.mark.parametrize(
     "experiment, args",
@@ -232,6 +234,7 @@ def test_local_workers_leave_ctrl_c_to_the_parent(backend):
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the parent still gets Ctrl-C
 
 
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 def test_two_processes_writing_one_store_leave_one_record_per_run(make_cfg, tmp_path):
     runs = expand(make_cfg("hspf_ungm", *TINY))
     reference = Store(tmp_path / "reference", "hspf_ungm")
