@@ -8,7 +8,8 @@ from scipy import stats
 from replication.evidence.aggregate import summarise
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import estimate, mean, median, paired_difference, proportion
-from replication.evidence.verdict import Outcome, Verdict, judge_band, judge_value, stability_bands
+from replication.errors import ConfigError
+from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict, judge_band, judge_value, stability_bands
 from replication.report.published import load_published
 from replication.report.tables import Comparison
 
@@ -60,6 +61,8 @@ def test_estimate_fits_its_quantity():
     assert estimate(np.array([1.0, 2.0, 3.0]), quantity("rmse")).method == "t"
     assert quantity("correct_frames[iou>=0.5]").high == 1.0 and quantity("mota").high == 1.0
     assert quantity("ms_per_frame").machine_dependent
+    with pytest.raises(ConfigError, match="unknown metric 'ess_min'"):  # no direction guessed for a claim
+        quantity("ess_min")
 
 
 def test_paired_difference_is_the_t_interval_of_per_run_differences():
@@ -88,7 +91,7 @@ def test_cell_verdicts_need_equivalence_to_be_reproduced():
     assert judge_value(1.25 * spread.mean(), spread, rmse, paper_runs=2).outcome is Outcome.INCONCLUSIVE
     floor = np.full(20, 0.8) + rng.normal(0, 0.01, 20)
     below = judge_value(0.5, tight, rmse, floor=floor)
-    assert below.outcome is Outcome.NOT_REPRODUCED and below.why.startswith("below the Bayes floor")
+    assert below.outcome is Outcome.NOT_REPRODUCED and below.tag == BAYES_FLOOR
     assert judge_value(10.0, np.full(20, 0.5), quantity("ms_per_frame")).outcome is Outcome.NOT_TESTABLE
     assert judge_value(1.05, tight[:4], rmse) == Verdict(Outcome.NOT_TESTABLE, "too few runs (4)")
     assert judge_value(1.0, np.full(10, 1.0), rmse).outcome is Outcome.NOT_TESTABLE  # every run equal

@@ -11,6 +11,11 @@ def parse_condition(condition: str) -> dict[str, str]:
     return dict(part.split("=", 1) for part in condition.split(";") if part)
 
 
+def scene_of(experiment: dict, condition: str) -> str:
+    """The scene a run's condition names ('scene=Girl;N=10' -> 'Girl'), else the experiment's one scene."""
+    return parse_condition(condition).get("scene") or experiment["model"]["scene"]
+
+
 def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic: str = "mean") -> pd.DataFrame:
     """One row per (method, condition): runs, the statistic, its 95% interval (``ci_low``, ``ci_high``),
     how the interval was made, the variance over runs and the per-run values (``values``).  ``scale`` converts units (100: a percentage)."""

@@ -5,19 +5,24 @@ A record's metric names are the compute side's (``rmse``,
 kind of number each is, so that an interval fits its quantity:
 
 * ``binary``: a per-run yes/no outcome (a run failed, a target was tracked to
-  the end); its mean over runs is a proportion: Wilson interval.
+  the end); its mean over runs is a proportion: Clopper-Pearson interval.
 * ``bounded``: a per-run share or score with a range (share of correct frames,
-  precision, AUC, MOTA <= 1): BCa bootstrap over runs, clipped to the range.
-* ``positive``: non-negative and usually skewed (errors, counts, ESS): BCa
-  bootstrap over runs, clipped at 0.
-* ``real``: anything else (a signed deviation): BCa bootstrap over runs.
-* ``timing``: machine-dependent; its interval is the same bootstrap, and a
-  published timing is shown with the ratio ours / theirs, never judged.
+  precision, AUC, MOTA <= 1): t interval over runs, clipped to the range.
+* ``positive``: non-negative and usually skewed (errors, counts, ESS): t
+  interval over runs, clipped at 0.
+* ``real``: a signed number (a deviation, an improvement).
+* ``timing``: machine-dependent; a published timing is shown with the ratio
+  ours / theirs, never judged.
+
+The papers' own names for the numbers their tables print are declared too (a
+published cell's metric), and a metric declared nowhere is an error.
 """
 
 import math
 import re
 from dataclasses import dataclass, replace
+
+from replication.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -73,6 +78,14 @@ QUANTITIES = {
     "filter_s": Quantity("timing", label="filtering time (s)"),
     "wall_s": Quantity("timing", label="wall time (s)"),
     "fps": Quantity("timing", lower_is_better=False, label="frames per second"),
+    # the papers' own names for what their tables print (a published cell's metric)
+    "time": Quantity("timing", label="time per step (ms)"),
+    "run_time": Quantity("timing", label="run time (s)"),
+    "time_per_frame": Quantity("timing", label="time per frame (ms)"),
+    "success_rate": Quantity("bounded", 0.0, 100.0, lower_is_better=False, label="success rate (%)"),
+    "correct_tracking_rate": Quantity("bounded", 0.0, 100.0, lower_is_better=False,
+                                      label="correct tracking rate (%)"),
+    "improvement": Quantity("real", -math.inf, math.inf, lower_is_better=False, label="improvement (%)"),
 }
 _PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_to_end[cle<=20]
     (re.compile(r"correct_frames\[(.+)\]"), lambda rule: replace(_SHARE, label=f"share of frames with {rule}")),
@@ -82,11 +95,13 @@ _PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_t
 
 
 def quantity(metric: str) -> Quantity:
-    """The quantity a metric is; an unknown metric is taken as an unbounded real number."""
+    """The quantity a metric is.  An unknown metric is an error: which way is better sets the direction of
+    every claim on it, and nothing here guesses it."""
     if metric in QUANTITIES:
         return QUANTITIES[metric]
     for pattern, make in _PATTERNS:
         found = pattern.fullmatch(metric)
         if found:
             return make(found[1])
-    return Quantity("real", -math.inf, math.inf, label=metric)
+    raise ConfigError(f"unknown metric {metric!r}: declare what it is (range, which way is better) in "
+                      f"replication/evidence/quantities.py; known: {', '.join(sorted(QUANTITIES))}")

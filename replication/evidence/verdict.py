@@ -21,6 +21,7 @@ from replication.evidence.quantities import Quantity
 
 MIN_RUNS = 5  # no verdict from fewer runs
 TOLERANCE = 0.10  # a published number is reproduced within +-10 % of it where its table states no other
+BAYES_FLOOR = "bayes_floor"  # the tag of a published RMSE below what any filter achieves on average
 
 RULES = (  # the rules in words, one short paragraph per kind of test; every page prints them
     "Every decision is a one-sided test at 5 %, and every interval that decides is exact or holds its level at the "
@@ -71,17 +72,19 @@ class Verdict:
     why: str = ""
     p_for: float | None = None  # one-sided p-value that the paper's statement holds
     p_against: float | None = None  # p-value of the evidence against it (before Holm)
+    tag: str = ""  # what kind of verdict, for code to count: BAYES_FLOOR (never read back from the why)
 
     def __str__(self) -> str:
         return f"{self.outcome.value} ({self.why})" if self.why else self.outcome.value
 
     def as_dict(self) -> dict:
         return {"outcome": self.outcome.value, "why": self.why, "p_for": _number(self.p_for),
-                "p_against": _number(self.p_against)}
+                "p_against": _number(self.p_against), "tag": self.tag}
 
     @classmethod
     def from_dict(cls, data: dict) -> "Verdict":
-        return cls(Outcome(data["outcome"]), data.get("why", ""), data.get("p_for"), data.get("p_against"))
+        return cls(Outcome(data["outcome"]), data.get("why", ""), data.get("p_for"), data.get("p_against"),
+                   data.get("tag", ""))
 
 
 def decide(p_for, p_against) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -130,7 +133,7 @@ def judge_value(paper: float, values, quantity: Quantity, statistic: str = "mean
         below = mean_test(floor, paper).p_above  # H1: the floor lies above the paper's value
         if np.isfinite(below) and below < ALPHA:
             return Verdict(Outcome.NOT_REPRODUCED, f"below the Bayes floor {np.mean(floor):.3g} ({said_p(below)})",
-                           None, float(below))
+                           None, float(below), BAYES_FLOOR)
     if quantity.proportion:
         return _judge_rate(paper, values, quantity, paper_runs, tolerance * abs(paper))
     p_for, p_against = cell_test(paper, values, tolerance, paper_runs, statistic)

@@ -15,10 +15,10 @@ synthetic scene, a sequence not in the list) is left out.
 
 import pandas as pd
 
+from replication.evidence.aggregate import parse_condition
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import stratified_mean
 from replication.evidence.verdict import MIN_RUNS
-from replication.report.figures import parse_condition
 from replication.scenes.otb import otb_attributes
 
 METRICS = ("precision20", "success_auc")  # OTB's two scores

@@ -15,7 +15,7 @@ The hypotheses come from the video each run saw (its ``scene_seed``).
 import numpy as np
 import pandas as pd
 
-from replication.report.tracking_figures import _scene_name
+from replication.evidence.aggregate import scene_of
 from replication.scenes.factory import cached_sequence
 
 
@@ -36,7 +36,7 @@ def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
-    scene = experiment["scenes"][_scene_name(experiment, group["condition"].iloc[0])]
+    scene = experiment["scenes"][scene_of(experiment, group["condition"].iloc[0])]
     shares = []
     for _, run in group.iterrows():
         seed = run.get("scene_seed")

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from replication.evidence.robustness import DECISIVE
-from replication.evidence.verdict import Outcome, Verdict
+from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
 from replication.report.claims import Claim, Paper, Reading
 
 
@@ -116,7 +116,7 @@ def cell_tallies(cells: pd.DataFrame) -> dict[str, str]:
     for claim, owned in cells[cells["claim"] != ""].groupby("claim", sort=False):
         compared = owned[owned["outcome"] != ""]
         parts = [f"{n} {outcome}" for outcome, n in compared["outcome"].value_counts().items()]
-        floor = int(compared["verdict"].str.contains("below the Bayes floor").sum())
+        floor = int((compared["tag"] == BAYES_FLOOR).sum()) if "tag" in compared else 0
         if floor:
             parts.append(f"{floor} below the Bayes floor")
         if len(owned) > len(compared):

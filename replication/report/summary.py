@@ -68,7 +68,7 @@ def summary_table(
 
     Columns: the key columns, ``note``, ``paper_value`` (value and unit),
     ``ours`` ('mean [low, high]', or a rating), ``outcome`` and ``verdict`` (the
-    outcome and its why; empty where not compared), ``reason`` (why not
+    outcome and its why; empty where not compared), ``tag`` (the verdict's kind: ``bayes_floor``), ``reason`` (why not
     compared; empty where compared), ``claim`` (the claim the cell belongs to), ``also``
     (further rows of ours compared with the same cell), ``link`` (the
     experiment page's section, relative to ``reports/``) and ``link_text``.
@@ -83,12 +83,14 @@ def summary_table(
         key = tuple(str(cell[k]) for k in KEYS)
         found = by_key.get(key, [])
         row = {k: cell[k] for k in KEYS}
-        row.update(note=cell["note"], paper_value=_paper_value(cell), ours="", outcome="", verdict="", reason="",
-                   also="", our_condition="", runs="", link="", link_text="", claim=claims[index] if claims else "")
+        row.update(note=cell["note"], paper_value=_paper_value(cell), ours="", outcome="", verdict="", tag="",
+                   reason="", also="", our_condition="", runs="", link="", link_text="",
+                   claim=claims[index] if claims else "")
         if found:
             name, summary, entry = found[0]
             row["ours"] = _ours(entry)
             row["outcome"], row["verdict"] = _verdict(entry)
+            row["tag"] = (entry.get("verdict") or {}).get("tag", "")
             ours_named = entry.get("our_condition") or ""
             if ours_named != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
                 row["our_condition"] = ours_named
@@ -105,7 +107,7 @@ def summary_table(
             row["link"] = f"{name}/index.html#unmatched" if name in summaries else ""
             row["link_text"] = name if name in summaries else ""
         rows.append(row)
-    columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "reason",
+    columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "tag", "reason",
                "also", "claim", "link", "link_text"]
     return pd.DataFrame(rows, columns=columns)
 

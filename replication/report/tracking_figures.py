@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import to_rgb
 
+from replication.evidence.aggregate import scene_of
 from replication.report.attributes import absent, attribute_scores
 from replication.report.style import (
     axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
@@ -71,14 +72,9 @@ def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
     return group.sort_values("repetition").groupby("method", sort=False).head(1)
 
 
-def _scene_name(experiment: dict, condition: str) -> str:
-    scene = [p.split("=", 1)[1] for p in condition.split(";") if p.startswith("scene=")]
-    return scene[0] if scene else experiment["model"]["scene"]
-
-
 def _sequence(experiment: dict, condition_records: pd.DataFrame):
     """The sequence of a condition's runs and the targets they track."""
-    name = _scene_name(experiment, condition_records["condition"].iloc[0])
+    name = scene_of(experiment, condition_records["condition"].iloc[0])
     return cached_sequence(experiment["scenes"][name]), condition_records["per_frame"].iloc[0]["targets"]
 
 
@@ -124,7 +120,7 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
     blocks = []
     for condition, group in _by_condition(records):
         sequence, chosen = _sequence(experiment, group)
-        frames = _frames(spec, _scene_name(experiment, condition), sequence.n_frames)
+        frames = _frames(spec, scene_of(experiment, condition), sequence.n_frames)
         runs = list(_first_runs(group).iterrows())
         grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k,
                            method_look(run["method"]).colour) for _, run in runs] for k in frames]
