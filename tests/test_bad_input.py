@@ -150,6 +150,18 @@ def nan_row(girl):
     (girl / "groundtruth_rect.txt").write_text("\n".join(rows) + "\n")
 
 
+def word_in_a_row(girl):
+    rows = (girl / "groundtruth_rect.txt").read_text().splitlines()
+    rows[2] = "abc,1,2,3"
+    (girl / "groundtruth_rect.txt").write_text("\n".join(rows) + "\n")
+
+
+def short_row(girl):
+    rows = (girl / "groundtruth_rect.txt").read_text().splitlines()
+    rows[6] = ",".join(rows[6].replace("\t", ",").split(",")[:3])
+    (girl / "groundtruth_rect.txt").write_text("\n".join(rows) + "\n")
+
+
 def empty_first_box(girl):
     rows = (girl / "groundtruth_rect.txt").read_text().splitlines()
     x, y, _, h = rows[0].replace("\t", ",").split(",")
@@ -163,6 +175,8 @@ def empty_first_box(girl):
         (break_frame, "0005.jpg: not a readable image"),
         (resize_frame, "0005.jpg: 64x48 pixels where the frames before it are 128x96"),
         (nan_row, "groundtruth_rect.txt:5: a ground-truth box that is not four finite numbers"),
+        (word_in_a_row, "groundtruth_rect.txt:3: a ground-truth box that is not four numbers: 'abc,1,2,3'"),
+        (short_row, "groundtruth_rect.txt:7: a ground-truth box of 3 numbers, not 4"),
         (empty_first_box, "groundtruth_rect.txt:1: the first box has no area"),
     ],
 )

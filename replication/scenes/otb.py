@@ -26,15 +26,21 @@ ATTRIBUTES_FILE = Path(__file__).with_name("otb_attributes.yaml")
 
 
 def read_groundtruth(path: Path) -> np.ndarray:
-    """Boxes (T, 4) from an OTB ground-truth file, converted to 0-based coordinates."""
-    rows = [
-        [float(v) for v in re.split(r"[,\s]+", line.strip())]
-        for line in path.read_text().splitlines()
-        if line.strip()
-    ]
-    boxes = np.array(rows, dtype=float)
-    if boxes.ndim != 2 or boxes.shape[1] != 4:
-        raise ValueError(f"{path}: expected 4 numbers per line")
+    """Boxes (T, 4) from an OTB ground-truth file, converted to 0-based coordinates; a row that is not four
+    numbers fails naming the file and line."""
+    rows = []
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        if not line.strip():
+            continue
+        tokens = re.split(r"[,\s]+", line.strip())
+        try:
+            row = [float(v) for v in tokens]
+        except ValueError:
+            raise ValueError(f"{path}:{number}: a ground-truth box that is not four numbers: {line.strip()!r}") from None
+        if len(row) != 4:
+            raise ValueError(f"{path}:{number}: a ground-truth box of {len(row)} numbers, not 4: {line.strip()!r}")
+        rows.append(row)
+    boxes = np.array(rows, dtype=float).reshape(-1, 4)
     boxes[:, :2] -= 1.0
     return boxes
 
