@@ -58,3 +58,39 @@ def test_one_report_judges_against_one_published_values_file(tmp_path):
     write_index(tmp_path / "reports", own)
     summary = pd.read_csv(tmp_path / "reports" / "summary.csv", keep_default_na=False, dtype=str)
     assert list(summary["paper_value"]) == ["9.99"] and list(summary["note"]) == ["a number of my own"]
+
+
+def _module_graph() -> dict[str, set[str]]:
+    """Each module of the package and the package modules it imports (at the top or inside a function)."""
+    modules = {".".join(("replication", *p.relative_to(PACKAGE_DIR).with_suffix("").parts)).removesuffix(".__init__"): p
+               for p in PACKAGE_DIR.rglob("*.py")}
+    graph = {}
+    for name, path in modules.items():
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                found |= {a.name for a in node.names if a.name in modules}
+            elif isinstance(node, ast.ImportFrom) and node.module in modules:
+                found.add(node.module)
+                found |= {f"{node.module}.{a.name}" for a in node.names if f"{node.module}.{a.name}" in modules}
+        graph[name] = found - {name}
+    return graph
+
+
+def test_no_import_circle_in_the_package():
+    graph = _module_graph()
+    state: dict[str, int] = {}
+
+    def visit(module: str, path: list[str]) -> None:
+        state[module] = 1  # on the path
+        for imported in sorted(graph[module]):
+            if state.get(imported) == 1:
+                circle = path[path.index(imported):] + [imported]
+                raise AssertionError("import circle: " + " -> ".join(circle))
+            if imported not in state:
+                visit(imported, path + [imported])
+        state[module] = 2  # done
+
+    for module in sorted(graph):
+        if module not in state:
+            visit(module, [module])

@@ -17,10 +17,11 @@ from replication.evidence.verdict import RULES, Verdict
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.claims import evaluate
-from replication.report.figures import NothingToDraw, draw
+from replication.report.figures import draw
 from replication.report.published import cells, load_published
 from replication.report.render import html_table, render
 from replication.report.scale import scale_changes, scale_note
+from replication.report.style import NothingToDraw
 from replication.report.tables import TableKind
 from replication.run import Run
 from replication.runner.config import experiment_at_scale

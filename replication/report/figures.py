@@ -215,10 +215,6 @@ def _figures():
     }
 
 
-class NothingToDraw(ValueError):
-    """The runs at hand cannot make this figure (a ranking of one method, say): the page leaves it out."""
-
-
 def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
          published: pd.DataFrame | None = None) -> Path:
     """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.

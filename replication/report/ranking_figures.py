@@ -7,9 +7,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from replication.report.figures import NothingToDraw
 from replication.evidence.ranking import rankings, unreliable
-from replication.report.style import OUTCOME_COLOURS, axis_label, save
+from replication.report.style import OUTCOME_COLOURS, NothingToDraw, axis_label, save
 
 LUMA = np.array([0.299, 0.587, 0.114])  # a colour's lightness: dark segments take white text
 

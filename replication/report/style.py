@@ -1,4 +1,5 @@
-"""How every figure of the report looks: one look per method, human axis labels, diverged runs clipped.
+"""How every figure of the report looks and is written: one look per method, human axis labels, diverged
+runs clipped, the figure saved (or, where the runs cannot make it, :class:`NothingToDraw`).
 
 A method (its config key) has the same colour, line style and marker on every
 figure of every experiment.  The colours are the Okabe-Ito palette, safe for
@@ -191,6 +192,10 @@ def clip_diverged(values, level: float | None) -> tuple[np.ndarray, np.ndarray]:
 def clipped_note(diverged: int, runs: int) -> str:
     """What a legend says of the diverged runs of a line (nothing when none did)."""
     return f" ({diverged} of {runs} runs diverged, clipped)" if diverged else ""
+
+
+class NothingToDraw(ValueError):
+    """The runs at hand cannot make this figure (a ranking of one method, say): the page leaves it out."""
 
 
 def save(fig, path: Path, dpi: int = 110) -> Path:
