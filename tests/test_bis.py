@@ -6,7 +6,7 @@ from omegaconf import OmegaConf
 
 from replication.filters.bis import bootstrap_histograms, box_overlap, log_potential
 from replication.paths import CONF_DIR
-from replication.runner.config import at_scale
+from replication.scales import at_scale
 from replication.scenes.factory import build_sequence
 
 

@@ -11,7 +11,7 @@ from replication.paths import CONF_DIR, resolve
 from replication.report import figures, tracking_figures
 from replication.report.published import load_published
 from replication.report.style import (
-    METHODS, PALETTE, axis_label, clip_diverged, method_look,
+    METHODS, PALETTE, NothingToDraw, axis_label, clip_diverged, method_look,
 )
 
 PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
@@ -185,8 +185,11 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
     records = pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]})
-    with pytest.raises(ValueError, match="no runs at conditions"):
+    with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
         figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")
+    no_strip = pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0]})  # no 3123 scene run
+    with pytest.raises(NothingToDraw, match="no run recorded a strip"):
+        tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
     seen = []
     monkeypatch.setattr(figures, "_figures", lambda: {"probe": lambda r, s, e, p: seen.append(sorted(r["condition"])) or p})
     figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")

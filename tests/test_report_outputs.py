@@ -131,7 +131,8 @@ def test_matched_cells_name_every_published_cell_a_table_matched(name):
         pytest.skip("../shared is not beside the project")
     from omegaconf import OmegaConf
 
-    from replication.runner.config import at_scale, expand
+    from replication.runner.config import expand
+    from replication.scales import at_scale
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={name}", "scale=quick", "experiment.runs.quick=3"])

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hydra import compose, initialize_config_dir
+from omegaconf import OmegaConf
 from conftest import PROJECT_ROOT
 
 from replication.scenes import OTBSequence, SyntheticScene
@@ -194,7 +196,7 @@ def _3123(hidden_motion):
     from omegaconf import OmegaConf
 
     from replication.paths import CONF_DIR
-    from replication.runner.config import at_scale
+    from replication.scales import at_scale
     from replication.scenes.factory import build_sequence
 
     experiment = OmegaConf.to_container(OmegaConf.load(CONF_DIR / "experiment" / "bis_pf.yaml"))
@@ -240,3 +242,37 @@ def test_random_walk_noise_on_velocity_or_position():
     np.testing.assert_allclose(np.diff(on_position, axis=0), [1.0, 0.5] + e)
     with pytest.raises(SceneError, match="noise_on"):
         trajectory({**walk, "noise_on": "size"}, 6, (400, 400), np.random.default_rng(1))
+
+
+def _with_synthetic_scenes() -> list[str]:
+    """The shipped experiments with a synthetic scene, read from their configs."""
+    from replication.paths import CONF_DIR, experiment_names
+
+    found = []
+    for name in experiment_names():
+        with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+            cfg = compose("config", overrides=[f"experiment={name}"])
+        scenes = OmegaConf.to_container(cfg.experiment.scenes, resolve=True) if "scenes" in cfg.experiment else {}
+        if any(spec.get("kind", "synthetic") == "synthetic" for spec in scenes.values()):
+            found.append(name)
+    return found
+
+
+@pytest.mark.parametrize("name", _with_synthetic_scenes())
+def test_the_scenes_command_writes_every_synthetic_scene_at_the_scale_asked(name, tmp_path):
+    from replication.scenes.__main__ import main
+
+    main([f"experiment={name}", "scale=quick", f"out={tmp_path}", "format=images"])
+    written = [p for p in tmp_path.iterdir() if p.is_dir()]
+    assert written and all(len(list((p / "img").glob("*.jpg"))) > 0 for p in written)
+    assert all((p / "groundtruth_rect.1.txt").exists() for p in written)
+
+
+@pytest.mark.parametrize("argv, said", [(["experiment=bis_pf", "scale=huge"], "scale must be one of paper, quick"),
+                                        (["experiment=bis_pf", "frames=3"], "unknown option 'frames'")])
+def test_the_scenes_command_refuses_a_bad_request_in_one_line(argv, said, capsys):
+    from replication.scenes.__main__ import main
+
+    with pytest.raises(SystemExit) as stopped:
+        main(argv)
+    assert stopped.value.code == 2 and said in capsys.readouterr().err

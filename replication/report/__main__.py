@@ -97,7 +97,7 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
     from omegaconf.errors import OmegaConfBaseException
 
     from replication.report.sweep import default_metric, parse_sweep, sweep_records, write_sweep_report
-    from replication.runner.config import at_scale
+    from replication.scales import at_scale
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         try:

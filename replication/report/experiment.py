@@ -37,7 +37,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     records, failures = store.load(runs), store.failures(runs)  # failed runs: counted, in no statistic
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, built, files, results = [], [], {}, [], []
+    tables, figures, built, files, results, left_out = [], [], {}, [], [], []
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -54,7 +54,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             file = f"{figure_spec['name']}.png"
             try:
                 draw(records, figure_spec, experiment, out / file, published)
-            except NothingToDraw:  # as a table none of whose conditions ran: left out
+            except NothingToDraw as reason:  # as a table none of whose conditions ran: left out, and said
+                left_out.append(str(reason))
                 continue
             link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
             beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
@@ -92,6 +93,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             files=files,
             scenes=_scenes(experiment),
             figures=figures,
+            left_out=left_out,
             results=results,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)

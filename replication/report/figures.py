@@ -16,7 +16,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from replication.evidence.aggregate import parse_condition, summarise  # noqa: E402
 from replication.report.published import COLUMNS, cells  # noqa: E402
 from replication.report.style import (  # noqa: E402
-    BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+    BLACK, PAPER, NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
     shades,
 )
 
@@ -228,8 +228,9 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
         raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(figures)}")
     if "conditions" in spec:
         records = records[records["condition"].isin(spec["conditions"])]
-        if records.empty:
-            raise ValueError(f"figure {spec.get('name', spec['kind'])!r}: no runs at conditions {spec['conditions']}")
+        if records.empty:  # a scene the figure needs was not run (dropped by an override, say)
+            raise NothingToDraw(f"figure {spec.get('name', spec['kind'])!r}: no runs at conditions "
+                                f"{spec['conditions']}")
     if "paper_table" not in spec:
         return figures[spec["kind"]](records, spec, experiment, path)
     if published is None:

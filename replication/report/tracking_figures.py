@@ -11,7 +11,7 @@ from matplotlib.colors import to_rgb
 from replication.evidence.aggregate import scene_of
 from replication.report.attributes import absent, attribute_scores
 from replication.report.style import (
-    axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+    NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
 )
 from replication.scenes.factory import cached_sequence
 
@@ -167,7 +167,8 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
     runs = list(_first_runs(stripped).iterrows())
     if not runs:
-        raise ValueError("no run recorded a strip: give the scene a strip: {target: ...} block")
+        raise NothingToDraw(f"figure {spec.get('name', 'mode_strip')!r}: no run recorded a strip (a scene's "
+                            "strip: {target: ...} block, bis_pf's exp1_3123)")
     fig, axes = plt.subplots(len(runs), 1, figsize=(7, 2.6 * len(runs)), squeeze=False)
     for ax, (_, run) in zip(axes[:, 0], runs):
         sequence, _ = _sequence(experiment, run.to_frame().T)

@@ -22,8 +22,8 @@ from omegaconf import DictConfig, OmegaConf
 from replication.errors import ConfigError
 from replication.filters import FILTERS, build_filter
 from replication.run import Run
-from replication.runner.preflight import SCALES
 from replication.runner.provenance import code_digest
+from replication.scales import SCALES, at_scale
 from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
 
@@ -53,17 +53,6 @@ def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
         sort_keys=True,
     )
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
-
-
-def at_scale(value: Any, scale: str) -> Any:
-    """Replace every ``{paper: a, quick: b}`` inside ``value`` by the entry for ``scale``."""
-    if isinstance(value, dict):
-        if set(value) == set(SCALES):
-            return at_scale(value[scale], scale)
-        return {k: at_scale(v, scale) for k, v in value.items()}
-    if isinstance(value, list):
-        return [at_scale(v, scale) for v in value]
-    return value
 
 
 def experiment_at_scale(cfg: DictConfig) -> dict:

@@ -35,7 +35,8 @@ from scipy.stats import qmc
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, experiment_names
 from replication.run import Run
-from replication.runner.config import at_scale, experiment_at_scale
+from replication.runner.config import experiment_at_scale
+from replication.scales import at_scale
 from replication.runner.validate import prepare
 
 NAME = re.compile(r"[a-z][a-z0-9_]*")

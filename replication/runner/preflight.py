@@ -23,9 +23,9 @@ from omegaconf import DictConfig, ListConfig, OmegaConf
 
 from replication.errors import ConfigError
 from replication.paths import inside_project, project_dir, resolve
+from replication.scales import SCALES
 
 SAFE_NAME = re.compile(r"(?![.\s])[^/\\\x00-\x1f]+")  # one file name: no separator, no leading dot
-SCALES = ("paper", "quick")
 POSITIVE = re.compile(r"(sigma\w*|\w+_sigma|\w*_var|variance|Q|R)")  # a scale: zero or less is meaningless
 NOT_NEGATIVE = re.compile(r"(\w+_sd|P0)")  # a standard deviation: zero switches the noise off
 COUNTS = re.compile(r"(n_\w+|runs|steps|frames|iterations|bins|copies|samples)")  # positive integers

@@ -15,7 +15,8 @@ from omegaconf import DictConfig, OmegaConf
 from replication.errors import ConfigError
 from replication.paths import resolve
 from replication.run import Run
-from replication.runner.config import at_scale, expand
+from replication.runner.config import expand
+from replication.scales import at_scale
 from replication.runner.execute import BackendError, check_backend
 
 RESERVED_METHOD_KEYS = ("filter", "label", "sweep", "only", "observation")  # read by expand, not by the filter

@@ -1,7 +1,9 @@
-"""``python -m replication.scenes experiment=<name> [scene=<key>] [out=DIR] [format=mp4|images] [boxes=true]``.
+"""``python -m replication.scenes experiment=<name> [scale=paper|quick] [scene=<key>] [out=DIR] [format=mp4|images]
+[boxes=true]``.
 
 Writes the synthetic scenes of an experiment (its ``scenes:`` block; real
-sequences are already on disk) so a person can watch them.
+sequences are already on disk) at the scale asked for (the config's by
+default, as for every command), so a person can watch them.
 """
 
 import sys
@@ -12,21 +14,31 @@ from omegaconf import OmegaConf
 
 from replication.errors import fail
 from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.scales import SCALES, at_scale
 from replication.scenes.export import write_sequence
 from replication.scenes.factory import build_sequence
+
+OPTIONS = ("experiment", "scale", "scene", "out", "format", "boxes")
 
 
 def main(argv: list[str]) -> None:
     options = dict(arg.split("=", 1) for arg in argv if "=" in arg)
+    unknown = sorted(set(options) - set(OPTIONS)) + [arg for arg in argv if "=" not in arg]
+    if unknown:
+        fail(f"unknown option {unknown[0]!r} for scenes; known: {', '.join(OPTIONS)}")
     name = options.pop("experiment", None)
     if name not in experiment_names():
         fail(f"name an experiment with scenes: experiment=<name>; known: {', '.join(experiment_names())}")
     out = Path(options.pop("out", str(resolve("reports") / "scenes")))
     video = options.pop("format", "mp4") == "mp4"
     boxes = options.pop("boxes", "false").lower() == "true"
+    scale = options.pop("scale", None)
+    if scale is not None and scale not in SCALES:
+        fail(f"scale must be one of {', '.join(SCALES)}, got {scale!r}")
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[f"experiment={name}"])
+        cfg = compose("config", overrides=[f"experiment={name}"] + ([f"scale={scale}"] if scale else []))
     scenes = OmegaConf.to_container(cfg.experiment.scenes, resolve=True) if "scenes" in cfg.experiment else {}
+    scenes = at_scale(scenes, cfg.scale)  # a scene's frames may differ by scale ({paper: 1000, quick: 100})
     chosen = options.pop("scene", None)
     synthetic = {k: v for k, v in scenes.items() if v.get("kind", "synthetic") == "synthetic" and chosen in (None, k)}
     if not synthetic:
