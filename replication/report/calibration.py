@@ -129,7 +129,7 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
                                                                    "power": 4})
     page = out / "index.html"
     page.write_text(render(
-        "calibration.html.j2", title="How often the verdict rules err: calibration", module=calibration.__doc__,
+        "calibration.html.j2", title="How often the verdict rules err: calibration",
         failed=failures(table), table=html_table(shown), replications=int(table["replications"].max()),
         rows=len(table), floor=2.0 ** -5, detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page
