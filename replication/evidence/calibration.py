@@ -69,9 +69,8 @@ def noise(distribution: str, rng: np.random.Generator, shape) -> np.ndarray:
     if distribution == "t3":
         return rng.standard_t(3, shape) / math.sqrt(3.0)
     if distribution == "lognormal":
-        s2 = LOGNORMAL_SIGMA ** 2
-        return (rng.lognormal(0.0, LOGNORMAL_SIGMA, shape) - math.exp(s2 / 2)) / math.sqrt(
-            (math.exp(s2) - 1) * math.exp(s2))
+        mean, sd = _lognormal_moments()
+        return (rng.lognormal(0.0, LOGNORMAL_SIGMA, shape) - mean) / sd
     raise ValueError(f"unknown distribution {distribution!r}; known: {DISTRIBUTIONS}")
 
 
@@ -157,12 +156,18 @@ def threshold_case(runs, distribution, truth, guards, effect) -> Case:
     return Case("threshold (median)", runs, 1, distribution, truth, guards, effect, draw)
 
 
+def _lognormal_moments() -> tuple[float, float]:
+    """The mean and standard deviation of a lognormal of log-scale 0 and ``LOGNORMAL_SIGMA``."""
+    s2 = LOGNORMAL_SIGMA ** 2
+    return math.exp(s2 / 2), math.sqrt((math.exp(s2) - 1) * math.exp(s2))
+
+
 def _median(distribution: str) -> float:
-    """The median of :func:`noise`'s draws."""
+    """The median of :func:`noise`'s draws (the lognormal's is 1 before standardising)."""
     if distribution != "lognormal":
         return 0.0
-    s2 = LOGNORMAL_SIGMA ** 2
-    return (1.0 - math.exp(s2 / 2)) / math.sqrt((math.exp(s2) - 1) * math.exp(s2))
+    mean, sd = _lognormal_moments()
+    return (1.0 - mean) / sd
 
 
 def cell_case(runs, distribution, truth, guards, mean, paper_runs=None) -> Case:

@@ -82,8 +82,7 @@ class Ranking:
     def rank(self, i: int) -> Estimate:
         """Method ``i``'s mean rank over the bootstrap resamples (description) and its 95% rank set
         (:func:`rank_set`: what the sequences show, not what the resamples of a few of them suggest)."""
-        low, high = rank_set(np.stack([self.per_sequence(j) for j in range(len(self.methods))], axis=-1), i,
-                             self.lower_is_better)
+        low, high = rank_set(self.per_sequence_means, i, self.lower_is_better)
         mean = round(float(self.mean_rank[i]), 2)
         return Estimate(mean, float(low), float(high), len(self.sequences), "rank set, paired t over sequences")
 
@@ -94,8 +93,13 @@ class Ranking:
         low, high = np.quantile(self.means[:, i], [(1 - LEVEL) / 2, (1 + LEVEL) / 2])
         return Estimate(value, float(low), float(high), self.runs, "two-level bootstrap, percentile")
 
+    @property
+    def per_sequence_means(self) -> np.ndarray:
+        """Sequences x methods: each method's mean over its runs on each sequence."""
+        return self.scores.mean(axis=1)
+
     def per_sequence(self, i: int) -> np.ndarray:
-        return self.scores[:, :, i].mean(axis=1)
+        return self.per_sequence_means[:, i]
 
     def difference(self, a: int, b: int) -> Estimate:
         """Mean over the sequences of the per-sequence difference a - b, t interval over the sequences."""

@@ -131,9 +131,8 @@ class Result:
         held = sum(c.verdict.outcome is Outcome.REPRODUCED for c in checks)
         said = "; ".join(filter(None, [deciding.number, deciding.verdict.why]))
         why = f"{held} of {len(testable)} checks hold; {deciding.what}" + (f": {said}" if said else "")
-        p = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_for[i]
-        return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(p if outcome is Outcome.NOT_REPRODUCED
-                                                                     else p_against[i])), tuple(checks), deciding)
+        against = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_against[i]  # what decided it
+        return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(against)), tuple(checks), deciding)
 
     def as_dict(self) -> dict:
         def check(c: Check) -> dict:
@@ -152,7 +151,7 @@ def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) ->
     if outcome is check.verdict.outcome or check.verdict.outcome is Outcome.NOT_TESTABLE:
         return check
     own = check.verdict
-    why = f"{own.why}; not significant after Holm across {family} checks (p = {adjusted:.2g})" \
+    why = f"{own.why}; not significant after Holm across {family} checks ({said_p(adjusted)})" \
         if own.outcome is Outcome.NOT_REPRODUCED else own.why
     return Check(check.what, Verdict(outcome, why, own.p_for, own.p_against), check.estimate, check.unit,
                  check.reference, check.per_run)
@@ -377,8 +376,7 @@ class Best(ClaimTest):
         if found is None or method not in found.methods:
             return []
         i = found.index(method)
-        per_sequence = np.stack([found.per_sequence(j) for j in range(len(found.methods))], axis=-1)
-        tested = best_test(per_sequence, i, found.lower_is_better)
+        tested = best_test(found.per_sequence_means, i, found.lower_is_better)
         caveat = unreliable(found, self.experiment)
         rank = found.rank(i)
         description = f"P(best) = {found.p_best[i]:.2f}, rank [{rank.low:.0f}, {rank.high:.0f}] (description only)"
