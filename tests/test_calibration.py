@@ -2,7 +2,6 @@
 
 import shutil
 
-import pandas as pd
 import pytest
 import yaml
 
@@ -13,9 +12,6 @@ from replication.report.calibration import CSV, NOTE, evidence_digest, failures,
 from replication.report.claims import load_papers
 
 SHIPPED = PACKAGE_DIR.parent / "reports" / CSV
-# the one place no test of a mean can hold its level at a few runs (Bahadur & Savage): a single mean of
-# skewed per-run values against a published number; the claims' paired comparisons hold everywhere
-KNOWN = ("published value", "lognormal")
 
 
 @pytest.fixture(scope="module")
@@ -23,15 +19,10 @@ def quick():
     return calibration.calibrate(calibration.QUICK_REPLICATIONS, runs=(5, 20))
 
 
-def _beyond_the_known(table: pd.DataFrame, standard_errors: float = 2.0) -> pd.DataFrame:
-    failed = failures(table, standard_errors)
-    return failed[~((failed["test"] == KNOWN[0]) & (failed["distribution"] == KNOWN[1]))]
-
-
 def test_every_rule_holds_its_level_under_every_null(quick):
     # about 100 null rows at 800 replications: a rule exactly at 5 % passes 2 standard errors in 2.3 % of
     # rows by chance, so the fast version allows 3 (the shipped table, at 10,000, is held to 2)
-    beyond = _beyond_the_known(quick, 3.0)
+    beyond = failures(quick, 3.0)
     assert beyond.empty, beyond[["test", "guards", "runs", "distribution", "rate"]]
 
 
@@ -58,7 +49,7 @@ def test_the_shipped_table_is_current_complete_and_precise():
     table = read(SHIPPED)
     assert len(table) == len(calibration.cases())
     assert (table["mc_se"] <= 0.005 + 1e-12).all()
-    assert _beyond_the_known(table).empty
+    assert failures(table).empty
     paper_power = table[(table["test"] == "order") & (table["truth"] == "effect") & (table["effect"] == 1.0)
                         & (table["runs"] == 100)]
     assert (paper_power["power"] >= 0.8).all() and len(paper_power) == 3

@@ -91,16 +91,16 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
     assert [u.name for u in multiverse.universes] == ["default", "hms=larger"]
     default = {r.run_id for r in multiverse.runs["default", "hspf_ungm"]}
     larger = {r.run_id for r in multiverse.runs["hms=larger", "hspf_ungm"]}
-    assert len(default) == len(larger) == 3 * 5  # PF, HSPF and the grid, 5 runs each
-    # PF and the grid are the same in both universes (one run each), HSPF differs
-    assert {i.split("__")[0] for i in default ^ larger} == {"HSPF"} and len(default & larger) == 10
-    assert len(multiverse.runs_of("hspf_ungm")) == 20
-    # the default universe's runs are the base experiment's own first runs: stored once, used by both
+    # the default universe is the base experiment itself, at its own 20 runs (the primary verdict's data);
+    # the other universe runs the multiverse's 5 of each
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         base = expand(compose("config", overrides=["experiment=hspf_ungm", "scale=quick"]))
-    assert default <= {r.run_id for r in base}
+    assert default == {r.run_id for r in base} and len(default) == 3 * 20 and len(larger) == 3 * 5
+    # PF and the grid are the same in both universes (their first 5 runs), HSPF differs
+    assert {i.split("__")[0] for i in larger - default} == {"HSPF"} and len(default & larger) == 10
+    assert len(multiverse.runs_of("hspf_ungm")) == 65
     store = Store(tmp_path / "store", "hspf_ungm")
-    assert execute(multiverse.runs_of("hspf_ungm"), store, n_jobs=1, backend="threading", progress=False) == 20
+    assert execute(multiverse.runs_of("hspf_ungm"), store, n_jobs=1, backend="threading", progress=False) == 65
     page = write_multiverse_report(cfg, multiverse)
     summary = OmegaConf.to_container(OmegaConf.load(page.parent / "summary.json"))
     claim = summary["multiverse"]["hspf.ungm"]

@@ -8,7 +8,7 @@ import pytest
 from replication.evidence.verdict import Outcome
 from replication.report import figures, ranking_figures
 from replication.report.claims import ClaimTest, Result
-from replication.evidence.ranking import rank, rankings
+from replication.evidence.ranking import held_out, rank, rankings
 from replication.report.tables import Table, TableKind
 
 SEQUENCES = [f"s{i}" for i in range(6)]
@@ -143,3 +143,17 @@ def test_ranking_and_pairwise_tables_and_the_figure(tmp_path, keep_figures):
     figures.draw(records, {**spec, "title": "t"}, experiment, tmp_path / "r.png")
     title = drawn[0].axes[0].get_title(loc="left")
     assert "not reliable" in title and "6 sequences x 1 run(s)" in title
+
+
+def test_leaving_one_sequence_out_counts_the_shown_orders_that_hold_on_it():
+    # method 0 far ahead of 1 and 2 on every sequence (by 1.0, spread 0.1): with any 5 of 6 sequences the
+    # paired t shows both orders, from 0's family and from each loser's; 1 and 2 are level (no order shown)
+    rng = np.random.default_rng(3)
+    per_sequence = np.array([[2.0, 1.0, 1.0]]) + 0.1 * rng.standard_normal((6, 3))
+    held, shown = held_out(per_sequence, lower_is_better=False)
+    assert shown == 6 * 4 and held == shown  # 0 > 1 and 0 > 2, each seen from both sides, in 6 folds
+    # a sequence on which the order reverses: the orders shown without it fail on it
+    reversed_last = per_sequence.copy()
+    reversed_last[-1] = [0.0, 1.0, 1.0]
+    held, shown = held_out(reversed_last, lower_is_better=False)
+    assert shown >= 4 and held == shown - 4  # the fold leaving out the reversed sequence: its 4 orders fail

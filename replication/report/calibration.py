@@ -27,6 +27,7 @@ from tqdm.auto import tqdm  # noqa: E402
 
 from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import ALPHA, detectable  # noqa: E402
+from replication.evidence.verdict import EQUIVALENCE_ALPHA  # noqa: E402
 from replication.paths import CONF_DIR, PACKAGE_DIR, resolve  # noqa: E402
 from replication.report.render import html_table, render  # noqa: E402
 
@@ -131,7 +132,7 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     page.write_text(render(
         "calibration.html.j2", title="How often the verdict rules err: calibration",
         failed=failures(table), table=html_table(shown), replications=int(table["replications"].max()),
-        rows=len(table), floor=2.0 ** -5, detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
+        rows=len(table), floor=2.0 ** -5, equivalence_alpha=EQUIVALENCE_ALPHA, detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page
 
 

@@ -344,11 +344,26 @@ class Discrepancy(TableKind):
 
 
 def _note(found: dict[str, Ranking], experiment: dict) -> str:
-    """The line under a ranking that is not reliable ('' when every ranking of the table is)."""
+    """The lines under a ranking: why it is not reliable (if so), and how its rank sets fare on a sequence
+    left out."""
     said = "; ".join(dict.fromkeys(filter(None, (unreliable(r, experiment) for r in found.values()))))
-    if not said:
+    caveat = f"{said[:1].upper()}{said[1:]}: the probabilities describe these runs and decide no claim. " if said else ""
+    return caveat + _held_out(list(found.values()))
+
+
+def _held_out(found: list[Ranking]) -> str:
+    """'Leaving one sequence out, ...': how many orders the other sequences show hold on the one left out
+    (summed over the table's rankings of three sequences or more)."""
+    found = [r for r in found if len(r.sequences) >= 3]
+    if not found:
         return ""
-    return f"{said[:1].upper()}{said[1:]}: the probabilities describe these runs and decide no claim."
+    held, shown = (sum(counts) for counts in zip(*(r.out_of_sample for r in found)))
+    sequences = max(len(r.sequences) for r in found)
+    if not shown:
+        return (f"Leaving one of the {sequences} sequences out, the others show no order between two methods: "
+                "the rank sets are as wide as so few sequences leave them.")
+    return (f"Leaving one of the {sequences} sequences out, {held} of the {shown} orders the others show between "
+            "two methods hold on the sequence left out.")
 
 
 class RankingTable(TableKind):

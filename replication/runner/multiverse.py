@@ -15,7 +15,9 @@ the run count and the experiments may differ by scale (``{paper: .., quick: ..}`
 Each universe's runs are the base experiments' runs with the alternatives'
 values set: they go through the same expansion, store (the base experiment's
 folder), seeds and backends as any run, and the run key hashes the changed
-config, so the default universe reuses the base experiments' stored runs and
+config, so the default universe (the base experiments as they stand, at
+their own run count, which the other universes share at theirs) reuses the
+base experiments' stored runs and
 a run shared by several universes (a method no choice touches) is computed
 once.
 """
@@ -222,7 +224,8 @@ def load(cfg: DictConfig) -> Multiverse:
                   for path, value in a.values.items()}
         for name, base in bases.items():
             experiment, _ = apply(base, values)
-            experiment["runs"] = {scale: runs_per_universe for scale in ("paper", "quick")}
+            if not universe.is_default:  # the default universe is the base experiments at their own run count
+                experiment["runs"] = {scale: runs_per_universe for scale in ("paper", "quick")}
             derived = OmegaConf.create({**top, "experiment": experiment})
             try:
                 runs[universe.name, name], missing, _ = prepare(derived)
