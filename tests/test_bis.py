@@ -98,7 +98,7 @@ def test_mrf_jpf_weights_are_likelihoods_times_potentials():
 
 
 def _state(n_targets):
-    from replication.filters.bis import JointState
+    from replication.filters.joint import JointState
 
     return JointState([None] * n_targets, np.random.default_rng(0), [None] * n_targets, [None] * n_targets)
 

@@ -27,22 +27,34 @@ def test_evidence_imports_nothing_above_it():
         assert not upward, (path.name, upward)
 
 
-def test_editing_the_deciding_or_drawing_code_keeps_every_run_key(tmp_path):
-    """A change of a verdict rule computes no run anew; a change of a filter does."""
+def test_a_run_is_keyed_by_the_code_it_runs(tmp_path):
+    """A change of a verdict rule or a drawing computes no run anew; a change of one filter recomputes the
+    runs of that filter (and of the filters built on it) and no other."""
     import shutil
 
-    from replication.runner.provenance import code_digest as cached
+    from replication.filters import FILTERS
+    from replication.runner.provenance import run_code_digest, source_of
+    from replication.tasks import TASKS
 
-    code_digest = cached.__wrapped__  # uncached: the same folder is hashed after each edit
-
+    digest = run_code_digest.__wrapped__  # uncached: the same folder is hashed after each edit
     package = tmp_path / "replication"
     shutil.copytree(PACKAGE_DIR, package, ignore=shutil.ignore_patterns("__pycache__", "conf"))
-    before = code_digest(package)
-    for edited in ("evidence/verdict.py", "report/tables.py"):
+    pairs = {(task, name): (source_of(TASKS[task]), source_of(FILTERS[name])) for task in TASKS for name in FILTERS}
+
+    def keys() -> dict:
+        return {pair: digest(entries, package) for pair, entries in pairs.items()}
+
+    before = keys()
+    for edited in ("evidence/verdict.py", "report/tables.py", "cli.py"):
         (package / edited).write_text((package / edited).read_text() + "\n# a new rule\n")
-        assert code_digest(package) == before, edited
-    (package / "filters/bootstrap.py").write_text((package / "filters/bootstrap.py").read_text() + "\n# x\n")
-    assert code_digest(package) != before
+        assert keys() == before, edited
+    (package / "filters/harmony.py").write_text((package / "filters/harmony.py").read_text() + "\n# x\n")
+    after = keys()
+    changed = {name for (task, name), key in after.items() if key != before[task, name]}
+    assert changed == {"hspf", "hs", "ms", "mspf"}  # harmony's own, and mean shift's, which imports it
+    assert all(after[task, name] != before[task, name] for task in TASKS for name in changed)
+    (package / "smc/loop.py").write_text((package / "smc/loop.py").read_text() + "\n# x\n")
+    assert all(key != after[pair] for pair, key in keys().items())  # the SMC core: every run
 
 
 def test_one_report_judges_against_one_published_values_file(tmp_path):

@@ -37,6 +37,7 @@ from replication.smc.loop import (
     Summaries,
     model_proposal,
 )
+from replication.filters.joint import JointFilter, JointState
 from replication.smc.resampling import multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
 
@@ -135,54 +136,6 @@ def _tally(draws, w, n):
         for k in range(draws.shape[1]):
             out[i, draws[i, k]] += w[k]
     return out
-
-
-@dataclass
-class JointState:
-    models: list
-    rng: np.random.Generator
-    particles: list
-    log_weights: list
-    t: int = 0
-
-    def __post_init__(self):
-        self.records = [Summaries() for _ in self.models]
-
-    def record(self, i: int, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
-        """Store target i's weighted particles after a step (the next step resamples them)."""
-        with np.errstate(divide="ignore"):
-            self.particles[i], self.log_weights[i] = particles, np.log(weights)
-        self.records[i].add(particles, weights, degenerate)
-        self.records[i].resampled.append(True)
-
-    def outputs(self) -> list[FilterOutput]:
-        return [r.output(log_evidence=float("nan")) for r in self.records]
-
-
-class JointFilter:
-    """What the joint filters share: one state for all targets, started from each target's prior.
-
-    Such a filter is its own multi-target tracker (:class:`replication.filters.tracker.Joint`).
-    """
-
-    n_particles: int
-
-    def start(self, models: list, rng: np.random.Generator) -> JointState:
-        n = self.n_particles
-        return JointState(models, rng, [m.sample_initial(n, rng) for m in models], [np.full(n, -np.log(n)) for _ in models])
-
-    def add(self, state: JointState, model) -> None:
-        """A target is born: its particles are drawn from ``model``'s prior (a real video's births)."""
-        n = self.n_particles
-        state.models.append(model)
-        state.particles.append(model.sample_initial(n, state.rng))
-        state.log_weights.append(np.full(n, -np.log(n)))
-        state.records.append(Summaries())
-
-    def remove(self, state: JointState, index: int) -> None:
-        """Target ``index`` dies: it leaves every list of the state."""
-        for kept in (state.models, state.particles, state.log_weights, state.records):
-            del kept[index]
 
 
 @dataclass

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.filters.bis import DistributedFilter, JointState, neighbours
+from replication.filters.bis import DistributedFilter, neighbours
+from replication.filters.joint import JointState
 
 
 @dataclass

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from replication.filters.bis import JointFilter, JointState, neighbours
+from replication.filters.bis import neighbours
+from replication.filters.joint import JointFilter, JointState
 
 
 @njit(cache=True)

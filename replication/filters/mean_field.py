@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.filters.bis import DistributedFilter, JointState, cloud_extents, log_potential, neighbours, reaching
+from replication.filters.bis import DistributedFilter, cloud_extents, log_potential, neighbours, reaching
+from replication.filters.joint import JointState
 from replication.smc.weights import normalise
 
 

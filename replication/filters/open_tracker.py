@@ -29,7 +29,7 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from replication.filters.bis import JointFilter
+from replication.filters.joint import JointFilter
 from replication.filters.mot_baselines import detection_boxes, detections_only, sort
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.metrics.mot import BOX

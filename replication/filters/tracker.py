@@ -15,7 +15,7 @@ Three kinds of tracker sit behind it:
   :class:`~replication.smc.loop.ParticleFilter` loop and its variants, the
   point-mass filter, the one-box OpenCV trackers), with the identity
   interaction: MIPF is literally this;
-* :class:`Joint`: a multi-target filter of :mod:`replication.filters.bis`
+* :class:`Joint`: a joint multi-target filter (:mod:`replication.filters.joint`)
   (BIS-PF, MFMC, DMOT, MRF-JPF, MCMC-PF) that steps all targets together;
 * both expose each target's posterior (:meth:`Tracker.posterior`) as weighted
   states; a one-box tracker states a point mass at its box.
@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
-from replication.filters.bis import JointFilter
+from replication.filters.joint import JointFilter
 from replication.smc.loop import FilterOutput
 
 Streams = Callable[[str], np.random.Generator]

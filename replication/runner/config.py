@@ -22,7 +22,7 @@ from omegaconf import DictConfig, OmegaConf
 from replication.errors import ConfigError
 from replication.filters import FILTERS, build_filter
 from replication.run import Run
-from replication.runner.provenance import code_digest
+from replication.runner.provenance import run_code_digest, source_of
 from replication.scales import SCALES, at_scale
 from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
@@ -46,12 +46,12 @@ def _sweeps(params: dict[str, Any], on_model: bool, where: str) -> list[tuple[bo
 
 
 def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
-    """Hash of everything that can change a run's numbers (not its repetition): the config and the code."""
+    """Hash of everything that can change a run's numbers (not its repetition): the config and the code the
+    run executes (its task's and its filter's modules and what they import)."""
     numeric = {k: v for k, v in method.items() if k != "label"}
-    blob = json.dumps(
-        {"task": task, "model": model, "method": numeric, "seed": base_seed, "code": code_digest()},
-        sort_keys=True,
-    )
+    code = run_code_digest((source_of(TASKS[task]), source_of(FILTERS[method["filter"]])))
+    blob = json.dumps({"task": task, "model": model, "method": numeric, "seed": base_seed, "code": code},
+                      sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
 
 

@@ -1,16 +1,23 @@
 """Which code, libraries and machine computed a run.
 
-:func:`code_digest` is part of every run key, so a change to any module that
-can change a run's numbers gives new runs rather than stale ones.  It hashes
-the source of every module of the package except those that never compute a run
-(:data:`READ_ONLY`: the evidence and report layers, the command line, the reader of stored records,
-the export of results for other toolkits).
+:func:`run_code_digest` is part of every run key: the source of the modules
+the run executes, found from its task and its filter through their imports,
+so a change to a module that can change a run's numbers gives new runs, and
+a change to one filter recomputes that filter's runs only.  A module that
+gathers others by name (:data:`GATHERING`: the package's top level, the
+filters' and tasks' registries) counts with its own source but not with every
+module it gathers.  :func:`code_digest` hashes every module that computes
+runs (all but :data:`READ_ONLY`: the evidence and report layers, the command
+line, the reader of stored records, the export of results for other
+toolkits): it goes into every record's provenance.
 :func:`provenance` is written into every record, and the report shows it.
 """
 
+import ast
 import datetime
 import hashlib
 import importlib.metadata
+import inspect
 import platform
 import subprocess
 from functools import lru_cache
@@ -22,6 +29,9 @@ PACKAGE = Path(__file__).resolve().parent.parent
 # other toolkits
 READ_ONLY = ("evidence/", "report/", "cli.py", "__main__.py", "scenes/__main__.py", "runner/preflight.py",
              "runner/results.py", "export.py")
+# modules that gather others by name (re-exports, registries): their source counts for a run that imports them,
+# the modules they gather do not (the run's own task and filter are its entries)
+GATHERING = ("__init__.py", "filters/__init__.py", "tasks/__init__.py")
 LIBRARIES = {"numpy": "numpy", "scipy": "scipy", "opencv": "opencv-python-headless", "numba": "numba"}  # column: distribution
 
 
@@ -35,6 +45,58 @@ def code_digest(package: Path = PACKAGE) -> str:
             continue
         digest.update(relative.as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:12]
+
+
+@lru_cache(maxsize=256)
+def run_code_digest(entries: tuple[str, ...], package: Path = PACKAGE) -> str:
+    """SHA-256 (12 hex digits) of the path and bytes of each source file a run executes: ``entries`` (paths
+    inside ``package``: its task's module, its filter's) and every module they import, transitively, with
+    the packages around them (a module in :data:`GATHERING` counts, the modules it imports do not)."""
+    found, todo = set(), list(entries)
+    while todo:
+        relative = todo.pop()
+        if relative in found:
+            continue
+        found.add(relative)
+        if relative not in GATHERING:
+            todo.extend(_imports(relative, package))
+    digest = hashlib.sha256()
+    for relative in sorted(found):
+        digest.update(relative.encode() + b"\0" + (package / relative).read_bytes() + b"\0")
+    return digest.hexdigest()[:12]
+
+
+def source_of(code) -> str:
+    """The path inside the package of the file that defines ``code`` (a module, class or function): an entry
+    of :func:`run_code_digest`."""
+    return Path(inspect.getsourcefile(code)).resolve().relative_to(PACKAGE).as_posix()
+
+
+def _imports(relative: str, package: Path) -> set[str]:
+    """The package's source files that importing ``relative`` runs: the modules it imports (anywhere in it,
+    functions included) and the ``__init__.py`` of every package on their way."""
+    tree = ast.parse((package / relative).read_text(), relative)
+    modules = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            modules.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            modules.add(node.module)
+            modules.update(f"{node.module}.{alias.name}" for alias in node.names)  # a submodule, if it is one
+    parts = Path(relative).with_suffix("").parts
+    modules.update(".".join((package.name, *parts[:i])) for i in range(len(parts)))  # its own packages
+    files = set()
+    for module in modules:
+        names = module.split(".")
+        if names[0] != package.name:
+            continue
+        for i in range(2, len(names) + 1):  # every package on the way runs its __init__.py
+            path = Path(*names[1:i])
+            for candidate in (path.with_suffix(".py"), path / "__init__.py"):
+                if (package / candidate).is_file():
+                    files.add(candidate.as_posix())
+    files.add("__init__.py")
+    return files
 
 
 @lru_cache(maxsize=1)

@@ -3,8 +3,8 @@
 Layout: ``<root>/<experiment>/runs/<method>__<condition>__<key>__r<rep>.json``, or, for a run that
 failed (:mod:`replication.runner.failures`), ``...__r<rep>.failed`` holding the reason.
 The key hashes everything that can change a run's numbers (task, model and
-method parameters, base seed, and the digest of the code that computes runs,
-:func:`replication.runner.provenance.code_digest`), so a changed config lands in
+method parameters, base seed, and the digest of the code the run executes,
+:func:`replication.runner.provenance.run_code_digest`), so a changed config or filter lands in
 new files and is never mixed with old runs, while adding repetitions, methods
 or sweep values reuses every run already stored.
 

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from replication.filters import build_filter
-from replication.filters.bis import JointFilter
+from replication.filters.joint import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator
 from replication.metrics.hota import hota
