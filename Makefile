@@ -5,7 +5,7 @@
 # make benchmark   time the SMC core on this machine (reports/benchmark/)
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
-# make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while replication/evidence/ is unchanged)
+# make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3

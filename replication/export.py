@@ -47,7 +47,7 @@ LAYOUTS = {"otb": "OTB2015", "got10k": "GOT-10k"}  # layout: the toolkit's folde
 
 def tracker_name(run: Run) -> str:
     """The method, with the run's conditions other than the scene: ``PF``, ``PF_N=10``."""
-    labels = [label for label in run.condition.split(";") if label and not label.startswith("scene=")]
+    labels = [f"{name}={value}" for name, value in run.condition.without("scene").values]
     return re.sub(r"[^\w.+=-]", "_", "_".join([run.method, *labels]))
 
 

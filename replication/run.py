@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from replication.condition import Condition
 from replication.seeding import seed_sequence
 
 
@@ -16,34 +17,34 @@ class Run:
     experiment: str
     task: str
     method: str
-    condition: str
+    condition: Condition
     repetition: int
     model: dict[str, Any]
     method_params: dict[str, Any]
     base_seed: int
     key: str
-    data_condition: str = ""
+    data_condition: Condition = Condition()  # the model's swept values alone: what the data depend on
 
     @property
     def run_id(self) -> str:
-        condition = self.condition or "default"
+        condition = str(self.condition) or "default"
         return f"{self.method}__{condition}__{self.key}__r{self.repetition:03d}"
 
     def rng(self, stream: str) -> np.random.Generator:
         """Independent generators: ``data`` is shared by every method at the same model
         condition and repetition (common random numbers); ``filter`` is the method's own."""
         if stream == "data":
-            identity = ("data", self.data_condition, self.repetition)
+            identity = ("data", str(self.data_condition), self.repetition)
         else:
-            identity = (stream, self.method, self.condition, self.repetition)
+            identity = (stream, self.method, str(self.condition), self.repetition)
         return np.random.default_rng(seed_sequence(self.base_seed, *identity))
 
     def identity(self) -> dict[str, Any]:
         return {
             "experiment": self.experiment,
             "method": self.method,
-            "condition": self.condition,
-            "data_condition": self.data_condition,
+            "condition": str(self.condition),
+            "data_condition": str(self.data_condition),
             "repetition": self.repetition,
             "run_key": self.key,
             "run_id": self.run_id,

@@ -78,3 +78,24 @@ def keep_figures(monkeypatch):
         return kept
 
     return patch
+
+
+def typed(records):
+    """Hand-written records as the store gives them: each condition label's variables also as typed columns
+    (``N=10;scene=a`` -> ``condition.N`` = 10, ``condition.scene`` = 'a'), the columns the report reads."""
+    import pandas as pd
+
+    from replication.condition import Condition
+
+    def value(text: str):
+        for kind in (int, float):
+            try:
+                return kind(text)
+            except ValueError:
+                pass
+        return text
+
+    conditions = [Condition(tuple((k, value(v)) for k, v in (p.split("=", 1) for p in label.split(";") if p)))
+                  for label in records["condition"]]
+    columns = pd.DataFrame([c.columns() for c in conditions], index=records.index, dtype=object)
+    return pd.concat([records, columns], axis=1) if len(columns.columns) else records

@@ -45,7 +45,7 @@ def test_a_rule_that_never_decides_would_fail_the_power_rows(quick):
 def test_the_shipped_table_is_current_complete_and_precise():
     assert SHIPPED.exists(), "run make calibrate and commit reports/calibration.csv and calibration.json"
     note = yaml.safe_load((SHIPPED.parent / NOTE).read_text())
-    assert note["evidence"] == evidence_digest(), "replication/evidence/ changed: run make calibrate"
+    assert note["evidence"] == evidence_digest(), "the deciding code changed: run make calibrate"
     table = read(SHIPPED)
     assert len(table) == len(calibration.cases())
     assert (table["mc_se"] <= 0.005 + 1e-12).all()

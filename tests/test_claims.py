@@ -6,6 +6,8 @@ import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
+from conftest import typed
+
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
@@ -53,9 +55,9 @@ def _records(effects: dict[str, float], runs: int = 20, metric: str = "rmse", no
     """Three methods on common data: run r of every method shares a base value, plus the method's effect."""
     rng = np.random.default_rng(1)
     base = rng.normal(5.0, 1.0, runs)
-    return pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
-                          metric: base[r] + effect + noise * rng.standard_normal()}
-                         for m, effect in effects.items() for r in range(runs)])
+    return typed(pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
+                                metric: base[r] + effect + noise * rng.standard_normal()}
+                               for m, effect in effects.items() for r in range(runs)]))
 
 
 def _verdict(spec: dict, records: pd.DataFrame) -> Verdict:
@@ -100,7 +102,7 @@ def test_holm_keeps_nine_checks_from_calling_a_claim_wrong_on_one_unlucky_check(
             rows += [{"method": "A", "condition": f"N={condition}", "data_condition": "", "repetition": r,
                       "rmse": 5.0 + shift}, {"method": "B", "condition": f"N={condition}", "data_condition": "",
                                             "repetition": r, "rmse": 5.0}]
-    records = pd.DataFrame(rows)
+    records = typed(pd.DataFrame(rows))
     checks = ClaimTest.of({"test": "order", "metric": "rmse", "order": ["A", "B"]}, EXPERIMENT).checks(records, {})
     first = checks[0].verdict
     assert first.outcome is Outcome.NOT_REPRODUCED and 9 * first.p_against > 0.05
@@ -164,7 +166,7 @@ def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
     published = pd.DataFrame({"paper": ["p"], "table": ["3"], "experiment": ["s"], "method": ["A"],
                               "metric": ["stability"], "condition": [""], "value": ["good"], "unit": [""],
                               "note": [""], "number": [np.nan]})
-    records = pd.DataFrame({"method": "A", "condition": "scene=s", "failed": [0.0] * 28 + [1.0] * 12})
+    records = typed(pd.DataFrame({"method": "A", "condition": "scene=s", "failed": [0.0] * 28 + [1.0] * 12}))
     spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability",
             "match": {"scene=s": {"experiment": "s"}}}
     table = Rating(spec, {"paper": "p", "methods": {"A": {}}}, published).build(records)

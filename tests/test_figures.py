@@ -7,6 +7,8 @@ import pytest
 import yaml
 from matplotlib.colors import to_hex
 
+from conftest import typed
+
 from replication.paths import CONF_DIR, resolve
 from replication.report import figures, tracking_figures
 from replication.report.published import load_published
@@ -30,13 +32,14 @@ def drawn(keep_figures):
 
 
 def _scalar_records(values: dict[tuple[str, str], list[float]]) -> pd.DataFrame:
-    return pd.DataFrame([{"method": m, "condition": c, "repetition": r, "rmse": v}
-                         for (m, c), runs in values.items() for r, v in enumerate(runs)])
+    return typed(pd.DataFrame([{"method": m, "condition": c, "repetition": r, "rmse": v}
+                               for (m, c), runs in values.items() for r, v in enumerate(runs)]))
 
 
 def _tracking_records(curves: dict[str, list[list[float]]]) -> pd.DataFrame:
-    return pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": r, "per_frame": {"cle": [None, *run]}}
-                         for m, runs in curves.items() for r, run in enumerate(runs)])
+    return typed(pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": r,
+                                "per_frame": {"cle": [None, *run]}}
+                               for m, runs in curves.items() for r, run in enumerate(runs)]))
 
 
 def _lines(fig, label: str) -> list:
@@ -184,10 +187,10 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 
 
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
-    records = pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]})
+    records = typed(pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]}))
     with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
         figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")
-    no_strip = pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0]})  # no 3123 scene run
+    no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0]}))  # no 3123 scene run
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):
         tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
     seen = []

@@ -74,7 +74,7 @@ def test_a_method_observation_block_overrides_the_model_observation(make_cfg):
     assert observation["color-only PF"]["alpha"] == 1.0 and observation["color-only PF"]["adaptive"] is False
     assert observation["color+structure fusion PF"]["adaptive"] is True
     assert observation["fusion-sigma-0.1"]["sigma"] == 0.1 and observation["color-only PF"]["sigma"] == 1.0
-    assert len({r.key for r in runs if r.condition == "scene=airplane"}) == 4
+    assert len({r.key for r in runs if str(r.condition) == "scene=airplane"}) == 4
 
 
 def test_a_turning_plane_moves_alpha_towards_colour():

@@ -10,6 +10,8 @@ from matplotlib.patches import Rectangle
 from mot_cases import COLUMNS, HAVE_MOT, motmetrics_accumulator, needs_mot, two_walkers
 from PIL import Image, ImageSequence
 
+from conftest import typed
+
 from replication.filters.mot_baselines import detections_only, sort
 from replication.metrics.mot import clear_mot_matches, drop_ignored, mot_metrics
 from replication.report import mot_figures
@@ -32,7 +34,7 @@ def stand_in_records(sequence, first=FIRST, last=LAST) -> pd.DataFrame:
         tracks = tracks[tracks["frame"].between(first, last)][COLUMNS].values.tolist()
         rows += [{"method": method, "condition": "scene=pets", "repetition": r, "tracks": tracks,
                   "first_frame": first, "last_frame": last} for r in range(2)]
-    return pd.DataFrame(rows)
+    return typed(pd.DataFrame(rows))
 
 
 @pytest.fixture(scope="module")

@@ -7,6 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import typed
+
 from replication.metrics import tracking as tm
 from replication.report import figures, tracking_figures
 from replication.report.tables import TableKind
@@ -28,7 +30,7 @@ def record(method: str, condition: str, repetition: int, errors: list[float], ov
 
 
 def hand_records() -> pd.DataFrame:
-    return pd.DataFrame([
+    return typed(pd.DataFrame([
         # A on Suv, two runs: precision 2/4 and 3/4, success 38/84 and 52/84 -> means 5/8 and 45/84
         record("A", "scene=suv", 0, [5, 25, 10, 40], [GOOD, POOR, 0.61, NONE]),
         record("A", "scene=suv", 1, [5, 5, 5, 40], [GOOD, GOOD, GOOD, NONE]),
@@ -39,7 +41,7 @@ def hand_records() -> pd.DataFrame:
         # not counted: a synthetic scene and a sequence OTB does not list
         record("A", "scene=blob", 0, [0, 0, 0, 0], [0.97] * 4),
         record("A", "scene=mine", 0, [0, 0, 0, 0], [0.97] * 4),
-    ])
+    ]))
 
 
 def test_attribute_table_averages_sequences_not_runs():
@@ -78,7 +80,7 @@ def test_attribute_interval_needs_five_runs_per_sequence_and_keeps_sequences_fix
         return [record("A", f"scene={scene};N=10", r, [5] * (4 - (r + precision) % 3) + [50] * ((r + precision) % 3),
                        [GOOD] * 4) for r in range(n)]
 
-    five = pd.DataFrame(runs("suv", 5, 0) + runs("girl", 5, 1))
+    five = typed(pd.DataFrame(runs("suv", 5, 0) + runs("girl", 5, 1)))
     occlusion = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(five).frame
     occlusion = occlusion[occlusion["attribute"].str.startswith("OCC")].iloc[0]
     estimate = occlusion["precision20"]
@@ -86,14 +88,14 @@ def test_attribute_interval_needs_five_runs_per_sequence_and_keeps_sequences_fix
     assert estimate.value == pytest.approx((suv + girl) / 2)
     assert estimate.low < estimate.value < estimate.high and 0.0 <= estimate.low and estimate.high <= 1.0
     assert occlusion["condition"] == "N=10" and occlusion["runs"] == 5 and estimate.runs == 10
-    four = pd.DataFrame(runs("suv", 5, 0) + runs("girl", 4, 1))
+    four = typed(pd.DataFrame(runs("suv", 5, 0) + runs("girl", 4, 1)))
     frame = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(four).frame
     defined = dict(zip(frame["attribute"].str.split().str[0], frame["precision20"].map(lambda e: e.defined)))
     assert defined == {"SV": False, "OCC": False, "IPR": False, "OPR": False, "OV": True}  # OV: Suv only
 
 
 def test_no_listed_sequence_gives_an_empty_table_and_every_listed_code_is_an_attribute():
-    synthetic = pd.DataFrame([record("A", "scene=blob", 0, [0], [0.9])])
+    synthetic = typed(pd.DataFrame([record("A", "scene=blob", 0, [0], [0.9])]))
     assert TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(synthetic).empty
     meanings, sequences = otb_attributes()
     assert list(meanings) == ["IV", "SV", "OCC", "DEF", "MB", "FM", "IPR", "OPR", "OV", "BC", "LR"]

@@ -125,7 +125,7 @@ def exported(tmp_path_factory):
                  "experiment.model.sweep.scene=[Girl]", "experiment.scenes.Girl.last.quick=30", "progress=false")
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=["experiment=ism_pf_otb", "scale=quick", *overrides])
-    runs = [r for r in expand(cfg) if r.method == "PF" and r.condition == "scene=Girl;N=10"]
+    runs = [r for r in expand(cfg) if r.method == "PF" and str(r.condition) == "scene=Girl;N=10"]
     store = Store(root / "store", "ism_pf_otb")
     execute(runs, store, n_jobs=1, progress=False)
     written = {layout: export_results("ism_pf_otb", "quick", root / "results", layout, overrides) for layout in LAYOUTS}

@@ -5,6 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import typed
+
 from replication.evidence.verdict import Outcome
 from replication.report import figures, ranking_figures
 from replication.report.claims import ClaimTest, Result
@@ -18,10 +20,10 @@ def _records(scores: np.ndarray, methods: list[str], metric: str = "precision20"
     """Run records from sequences x runs x methods scores: run r of every method on a sequence shares its
     data (``data_condition``, ``repetition``)."""
     rest = "".join(f";{k}={v}" for k, v in condition.items())
-    return pd.DataFrame([{"method": m, "condition": f"scene={s}{rest}", "data_condition": f"scene={s}",
-                          "repetition": r, metric: scores[i, r, j]}
-                         for i, s in enumerate(SEQUENCES[:scores.shape[0]]) for r in range(scores.shape[1])
-                         for j, m in enumerate(methods)])
+    return typed(pd.DataFrame([{"method": m, "condition": f"scene={s}{rest}", "data_condition": f"scene={s}",
+                                "repetition": r, metric: scores[i, r, j]}
+                               for i, s in enumerate(SEQUENCES[:scores.shape[0]]) for r in range(scores.shape[1])
+                               for j, m in enumerate(methods)]))
 
 
 def test_a_method_ahead_on_every_sequence_and_run_is_first_with_probability_one():

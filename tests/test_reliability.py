@@ -188,7 +188,9 @@ def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(m
     resumed = subprocess.run(cmd, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=120)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{len(runs) - after_sigkill} runs computed, {after_sigkill} already stored" in resumed.stdout
-    pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"), deterministic_columns(reference.load(runs)))
+    typed = [c for c in reference.load(runs) if c.startswith("condition.")]  # added on loading, not stored
+    pd.testing.assert_frame_equal(stored_table(store, "ungm_horizon"),
+                                  deterministic_columns(reference.load(runs).drop(columns=typed)))
 
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out

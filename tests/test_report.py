@@ -5,6 +5,8 @@ import pandas as pd
 import pytest
 from scipy import stats
 
+from conftest import typed
+
 from replication.evidence.aggregate import summarise
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import estimate, mean, median, paired_difference, proportion
@@ -154,7 +156,7 @@ def records():
             rows.append(
                 {"method": "PF", "condition": n, "data_condition": "", "repetition": rep, "rmse": floor + excess}
             )
-    return pd.DataFrame(rows)
+    return typed(pd.DataFrame(rows))
 
 
 def test_table_joins_paper_values_and_judges_against_the_floor(published):

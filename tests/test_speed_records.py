@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from replication.condition import Condition
 from replication.run import Run
 from replication.tasks import TASKS
 
@@ -66,7 +67,7 @@ KEYS = ("rmse", "mean_ess", "resample_rate", "mean_cle", "precision20", "success
 
 def record(name: str) -> dict:
     task, model, method = RUNS[name]
-    run = Run("speed_records", task, name, "", 0, model, method, base_seed=20240518, key=name)
+    run = Run("speed_records", task, name, Condition(), 0, model, method, base_seed=20240518, key=name)
     result = TASKS[task].run(run)
     return {k: float(result[k]) for k in KEYS if k in result}
 

@@ -38,7 +38,7 @@ from replication.evidence.comparisons import best_test
 from replication.evidence.inference import ALPHA, holm
 from replication.evidence.statistics import LEVEL, Estimate, paired_difference
 from replication.evidence.verdict import MIN_RUNS
-from replication.evidence.aggregate import parse_condition
+from replication.condition import label_of, values_of
 
 MIN_SEQUENCES = 5  # no ranking verdict over fewer sequences: one sequence more or less can reorder them
 RESAMPLES = 2999
@@ -191,11 +191,10 @@ def rankings(records: pd.DataFrame, spec: dict) -> dict[str, Ranking]:
     have leaves it out; a group of fewer than two entries is no ranking.
     """
     metric, over, by = spec["metric"], spec.get("over", "scene"), spec.get("by")
-    parts = records["condition"].map(parse_condition)
-    rest = parts.map(lambda p: ";".join(f"{k}={v}" for k, v in p.items() if k not in (over, by)))
+    rest = label_of(records, without=(over, by))
     frame = pd.DataFrame({
-        "group": parts.map(lambda p: f"{by}={p[by]}" if by in p else ""),
-        "sequence": parts.map(lambda p: p.get(over)),
+        "group": [f"{by}={value}" if value is not None else "" for value in values_of(records, by)],
+        "sequence": values_of(records, over),
         "repetition": records["repetition"],
         "entry": [m if not r else f"{m} ({r})" for m, r in zip(records["method"], rest)],
         "value": records[metric].astype(float),

@@ -15,7 +15,7 @@ synthetic scene, a sequence not in the list) is left out.
 
 import pandas as pd
 
-from replication.evidence.aggregate import parse_condition
+from replication.condition import label_of, values_of
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import stratified_mean
 from replication.evidence.verdict import MIN_RUNS
@@ -30,12 +30,10 @@ def sequence_attributes(records: pd.DataFrame, experiment: dict) -> pd.DataFrame
     listed = otb_attributes()[1]
     fixed = experiment.get("model", {}).get("scene")  # an experiment of one scene does not sweep it
     rows = []
-    for index, condition in records["condition"].items():
-        parts = parse_condition(condition)
-        spec = experiment.get("scenes", {}).get(parts.pop("scene", fixed), {})
+    for index, scene, series in zip(records.index, values_of(records, "scene"), label_of(records, ("scene",))):
+        spec = experiment.get("scenes", {}).get(scene or fixed, {})
         if spec.get("kind") == "otb" and spec["name"] in listed:
-            rows.append((index, spec["name"], ";".join(f"{k}={v}" for k, v in parts.items()),
-                         tuple(listed[spec["name"]])))
+            rows.append((index, spec["name"], series, tuple(listed[spec["name"]])))
     index, sequences, series, attributes = zip(*rows) if rows else ((), (), (), ())
     known = records.loc[list(index)].copy()
     known["sequence"], known["series"], known["attributes"] = sequences, series, attributes

@@ -4,14 +4,14 @@ The table is :func:`replication.evidence.calibration.calibrate`'s: every rule
 simulated through the code that decides, under normal, heavy-tailed and skewed
 noise, at the run and check counts the scales use.  It takes minutes, so it is
 kept beside a note of the code and replications that made it
-(``calibration.json``) and made again only when a file of
-``replication/evidence/`` changes or more replications are asked for:
+(``calibration.json``) and made again only when a module the calibration
+runs (``replication/evidence/calibration.py`` and what it imports) changes or
+more replications are asked for:
 ``make replicate`` reuses it.
 
     python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]
 """
 
-import hashlib
 import json
 import sys
 from pathlib import Path
@@ -28,19 +28,18 @@ from tqdm.auto import tqdm  # noqa: E402
 from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import ALPHA, detectable  # noqa: E402
 from replication.evidence.verdict import EQUIVALENCE_ALPHA  # noqa: E402
-from replication.paths import CONF_DIR, PACKAGE_DIR, resolve  # noqa: E402
+from replication.paths import CONF_DIR, resolve  # noqa: E402
 from replication.report.render import html_table, render  # noqa: E402
+from replication.runner.provenance import run_code_digest  # noqa: E402
 
 CSV = "calibration.csv"
 NOTE = "calibration.json"
 
 
 def evidence_digest() -> str:
-    """SHA-256 (12 hex digits) of the deciding code: what the calibration simulates."""
-    digest = hashlib.sha256()
-    for path in sorted((PACKAGE_DIR / "evidence").glob("*.py")):
-        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    return digest.hexdigest()[:12]
+    """SHA-256 (12 hex digits) of the deciding code the calibration simulates: its module and every module it
+    imports (:func:`~replication.runner.provenance.run_code_digest`)."""
+    return run_code_digest(("evidence/calibration.py",))
 
 
 def load_or_calibrate(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> pd.DataFrame:

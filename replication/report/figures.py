@@ -13,7 +13,8 @@ import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
-from replication.evidence.aggregate import parse_condition, summarise  # noqa: E402
+from replication.condition import label_of, values_of  # noqa: E402
+from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.report.published import COLUMNS, cells  # noqa: E402
 from replication.report.style import (  # noqa: E402
     BLACK, PAPER, NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
@@ -41,11 +42,9 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
     metric = spec["metric"]
     summary = _summary(records, metric, spec)
     summary = summary[summary["mean"].notna()]  # a metric the method does not have (the grid's ESS)
-    conditions = summary["condition"].map(parse_condition)
-    summary["x"] = conditions.map(lambda c: float(c.get(spec["x"], "nan")))
-    summary["panel"] = conditions.map(lambda c: c.get(spec.get("by"), ""))
-    summary["rest"] = conditions.map(lambda c: " ".join(f"{k}={v}" for k, v in c.items()
-                                                        if k not in (spec["x"], spec.get("by"))))
+    summary["x"] = pd.to_numeric(values_of(summary, spec["x"]), errors="coerce").astype(float)
+    summary["panel"] = ["" if v is None else str(v) for v in values_of(summary, spec.get("by"))]
+    summary["rest"] = label_of(summary, without=(spec["x"], spec.get("by")), sep=" ")
     colours = _series_colours(summary)
     paper = (paper_points(published, spec, experiment, set(summary["method"]))
              if published is not None and "paper_table" in spec else None)
@@ -161,8 +160,8 @@ def paper_points(published: pd.DataFrame, spec: dict, experiment: dict, methods:
     chosen = cells(published, experiment["paper"], spec["paper_table"], metric)
     chosen = chosen[chosen["method"].isin(methods) & chosen["number"].notna()]
     at = spec.get("paper_x", {})
-    x = [parse_condition(condition).get(spec["x"], at.get(scene))
-         for condition, scene in zip(chosen["condition"], chosen["experiment"])]
+    x = [at.get(scene) if value is None else value for value, scene in zip(values_of(chosen, spec["x"]),
+                                                                          chosen["experiment"])]
     points = pd.DataFrame({"method": chosen["method"], "x": pd.to_numeric(pd.Series(x, index=chosen.index)),
                            "value": chosen["number"] * spec.get("paper_scale", 1)})
     return points.dropna()

@@ -36,7 +36,7 @@ def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
-    scene = experiment["scenes"][scene_of(experiment, group["condition"].iloc[0])]
+    scene = experiment["scenes"][scene_of(experiment, group)]
     shares = []
     for _, run in group.iterrows():
         seed = run.get("scene_seed")

@@ -25,7 +25,7 @@ from matplotlib.patches import Rectangle
 from PIL import Image
 
 from replication.metrics.mot import BOX, clear_mot_matches
-from replication.evidence.aggregate import parse_condition
+from replication.condition import PREFIX, values_of
 from replication.report.style import method_label, save
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
 from replication.tasks.mot import frame_table
@@ -44,13 +44,14 @@ def track_colour(track_id: int) -> tuple[float, float, float]:
     return ID_COLOURS[(int(track_id) - 1) % len(ID_COLOURS)]
 
 
-def scene_key(condition: str) -> str:
-    return parse_condition(condition)["scene"]
+def scene_key(runs: pd.DataFrame) -> str:
+    """The scene (its key in the experiment's ``scenes``) of one condition's runs."""
+    return values_of(runs, "scene").iloc[0]
 
 
-def mot_sequence(experiment: dict, condition: str) -> MotSequence:
-    """The MOT sequence of a condition's scene."""
-    scene = experiment["scenes"][scene_key(condition)]
+def mot_sequence(experiment: dict, scene_key: str) -> MotSequence:
+    """The MOT sequence of a scene of the experiment."""
+    scene = experiment["scenes"][scene_key]
     return _load(scene["name"], scene.get("root", MOT_ROOT))
 
 
@@ -135,15 +136,16 @@ def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     the frames where the boxes are (the whole frame with ``crop: false``)."""
     rows = []
     several = records["condition"].nunique() > 1
-    for condition, group in records.groupby("condition", sort=False):
-        sequence = mot_sequence(experiment, condition)
+    for _, group in records.groupby("condition", sort=False):
+        scene = scene_key(group)
+        sequence = mot_sequence(experiment, scene)
         runs = [run for _, run in _first_runs(group).iterrows()]
-        frames = _snapshot_frames(spec, scene_key(condition), runs[0], sequence.n_frames)
+        frames = _snapshot_frames(spec, scene, runs[0], sequence.n_frames)
         tracks = [frame_table(run) for run in runs]
         window = _window(spec, sequence, frames, [sequence.truth, sequence.ignored, *tracks])
         for run, table in zip(runs, tracks):
             label = textwrap.fill(method_label(experiment, run["method"]), 24)
-            label += f"\n{scene_key(condition)}" if several else ""
+            label += f"\n{scene}" if several else ""
             rows.append((sequence, frames, table, label, window))
     n_cols = max(len(row[1]) for row in rows)
     heights = [2.5 * (y1 - y0) / (x1 - x0) + 0.3 for *_, (x0, y0, x1, y1) in rows]
@@ -191,14 +193,15 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
     where CLEAR MOT matches them (IoU >= 0.5, a match kept while it holds), a grey line where the person
     is in the ground truth but unmatched, a black tick at each identity switch."""
     panels = []
-    for condition, group in records.groupby("condition", sort=False):
-        sequence = mot_sequence(experiment, condition)
+    for _, group in records.groupby("condition", sort=False):
+        scene = scene_key(group)
+        sequence = mot_sequence(experiment, scene)
         for _, run in _first_runs(group).iterrows():
-            panels.append((condition, run, *timeline_matches(sequence, run)))
+            panels.append((scene, run, *timeline_matches(sequence, run)))
     lanes = [max(truth["id"].nunique(), 1) for _, _, truth, _ in panels]
     fig, axes = plt.subplots(len(panels), 1, squeeze=False, height_ratios=lanes,
                              figsize=(10, 0.8 * len(panels) + 0.2 * sum(lanes)))
-    for ax, (condition, run, truth, matches) in zip(axes[:, 0], panels):
+    for ax, (scene, run, truth, matches) in zip(axes[:, 0], panels):
         first, last = int(run["first_frame"]), int(run["last_frame"])
         ids = np.sort(truth["id"].unique())
         lane = {truth_id: k for k, truth_id in enumerate(ids)}
@@ -223,7 +226,7 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
         ax.tick_params(axis="x", labelsize=7)
         ax.grid(True, axis="x", alpha=0.3)
         covered = len(matches) / len(truth) if len(truth) else float("nan")
-        ax.set_title(f"{method_label(experiment, run['method'])}, {scene_key(condition)} (run "
+        ax.set_title(f"{method_label(experiment, run['method'])}, {scene} (run "
                      f"{run['repetition']}): {covered:.0%} of truth boxes matched, {len(switches)} identity "
                      f"switches", fontsize=8)
     axes[-1, 0].set_xlabel("frame")
@@ -239,7 +242,7 @@ def _video_run(records: pd.DataFrame, spec: dict) -> pd.Series:
     method = spec.get("method", records["method"].iloc[0])
     runs = records[records["method"] == method]
     if "scene" in spec:
-        runs = runs[runs["condition"].map(scene_key) == spec["scene"]]
+        runs = runs[values_of(runs, "scene") == spec["scene"]]
     if runs.empty:
         raise ValueError(f"track_video: no run of method {method!r}" + (f" on scene {spec['scene']!r}"
                                                                         if "scene" in spec else ""))
@@ -321,7 +324,7 @@ def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path)
     ``link: <name>.gif`` in the figure's spec for the report page to link it.
     """
     run = _video_run(records, spec)
-    sequence = mot_sequence(experiment, run["condition"])
+    sequence = mot_sequence(experiment, run[f"{PREFIX}scene"])
     first, last = spec.get("frames", (int(run["first_frame"]), int(run["first_frame"]) + 99))
     first = max(int(first), int(run["first_frame"]), 1)
     last = min(int(last), int(run["last_frame"]), sequence.n_frames)

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from replication.condition import PREFIX
+
 COLUMNS = ["paper", "table", "experiment", "method", "metric", "condition", "value", "unit", "note"]
 
 
@@ -24,7 +26,17 @@ def load_published(path: str) -> pd.DataFrame:
     if missing:
         raise ValueError(f"{path} lacks columns {sorted(missing)}")
     table["number"] = pd.to_numeric(table["value"], errors="coerce")
-    return table
+    return pd.concat([table, _variables(table["condition"])], axis=1)
+
+
+def _variables(conditions: pd.Series) -> pd.DataFrame:
+    """The file writes a cell's condition as a label ('N=10;runs=100'), the one place a label is read:
+    its variables as the columns our records have (``condition.N``, ``condition.runs``; strings, as every
+    cell of the file).  Words that assign nothing (a note on the setting) give no column."""
+    parsed = [dict(part.strip().split("=", 1) for part in text.split(";") if "=" in part and " " not in
+                   part.strip()) for text in conditions]
+    return pd.DataFrame([{f"{PREFIX}{k}": v for k, v in found.items()} for found in parsed], index=conditions.index,
+                        dtype=object)
 
 
 def cells(published: pd.DataFrame, paper: str, table, metric: str | None = None) -> pd.DataFrame:

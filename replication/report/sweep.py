@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from replication.condition import PREFIX, label_of
 from replication.errors import ConfigError
 from replication.evidence.aggregate import summarise
 from replication.report.figures import metric_vs_condition
@@ -73,7 +74,8 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
     stem = key.replace("/", "_")
     same = unaffected(records)
     tagged = records[~same]
-    tagged = tagged.assign(condition=[f"{c};{name}={v}".lstrip(";") for c, v in zip(tagged["condition"], tagged["swept"])])
+    tagged = tagged.assign(**{f"{PREFIX}{name}": tagged["swept"].astype(object)})
+    tagged = tagged.assign(condition=label_of(tagged))
     tagged = pd.concat([tagged, records[same & (records["swept"] == records["swept"].iloc[0])]])
     table = summarise(tagged, metric)
     table.to_csv(out / f"{stem}.csv", index=False)

@@ -74,7 +74,7 @@ def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
 
 def _sequence(experiment: dict, condition_records: pd.DataFrame):
     """The sequence of a condition's runs and the targets they track."""
-    name = scene_of(experiment, condition_records["condition"].iloc[0])
+    name = scene_of(experiment, condition_records)
     return cached_sequence(experiment["scenes"][name]), condition_records["per_frame"].iloc[0]["targets"]
 
 
@@ -120,7 +120,7 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
     blocks = []
     for condition, group in _by_condition(records):
         sequence, chosen = _sequence(experiment, group)
-        frames = _frames(spec, scene_of(experiment, condition), sequence.n_frames)
+        frames = _frames(spec, scene_of(experiment, group), sequence.n_frames)
         runs = list(_first_runs(group).iterrows())
         grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k,
                            method_look(run["method"]).colour) for _, run in runs] for k in frames]

@@ -19,6 +19,7 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
+from replication.condition import Condition
 from replication.errors import ConfigError
 from replication.filters import FILTERS, build_filter
 from replication.run import Run
@@ -26,13 +27,6 @@ from replication.runner.provenance import run_code_digest, source_of
 from replication.scales import SCALES, at_scale
 from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
-
-SHORT_NAMES = {"n_particles": "N", "steps": "T", "n_joint": "K"}
-
-
-def _label(name: str, value: Any) -> str:
-    return f"{SHORT_NAMES.get(name, name)}={value}"
-
 
 def _sweeps(params: dict[str, Any], on_model: bool, where: str) -> list[tuple[bool, str, list]]:
     """The (on_model, name, values) of a block's ``sweep:``, removed from ``params``."""
@@ -102,13 +96,11 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
             run_model, run_params = dict(model), dict(params)
             if observation:
                 run_model["observation"] = {**model.get("observation", {}), **observation}
-            labels, data_labels = [], []
             for (on_model, name, _), value in zip(sweeps, values):
                 (run_model if on_model else run_params)[name] = value
-                labels.append(_label(name, value))
-                if on_model:
-                    data_labels.append(labels[-1])
-            condition = ";".join(labels)
+            condition = Condition.of((name, value) for (_, name, _), value in zip(sweeps, values))
+            data_condition = Condition.of((name, value) for (on_model, name, _), value in zip(sweeps, values)
+                                          if on_model)
             if any(run_model.get(k, run_params.get(k)) not in allowed for k, allowed in only.items()):
                 continue
             if "scene" in run_model:
@@ -125,13 +117,11 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
             except (TypeError, ValueError, KeyError) as error:
                 where = f" ({condition})" if condition else ""
                 raise ConfigError(f"model{where}: {error}") from None
-            build_filter(method, run_params, condition)
+            build_filter(method, run_params, str(condition))
             key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed))
             runs.extend(
-                Run(
-                    exp.name, exp.task, method, condition, r, run_model, run_params,
-                    int(cfg.base_seed), key, ";".join(data_labels),
-                )
+                Run(exp.name, exp.task, method, condition, r, run_model, run_params, int(cfg.base_seed), key,
+                    data_condition)
                 for r in range(repetitions)
             )
     return runs

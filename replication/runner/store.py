@@ -177,12 +177,13 @@ class Store:
             raise
 
     def load(self, runs: list[Run]) -> pd.DataFrame:
-        """The sound records of ``runs`` that are stored, one row per run.
+        """The sound records of ``runs`` that are stored, one row per run, each with its run's condition
+        variables as typed columns (``condition.N``, ``condition.scene``: :mod:`replication.condition`).
 
         Corrupt files are left out (never aggregated) and named in one line on
         stderr; running the experiment again sets them aside and recomputes them.
         """
-        records, corrupt = [], []
+        records, conditions, corrupt = [], [], []
         for run in runs:
             try:
                 record = self.read(run)
@@ -191,13 +192,16 @@ class Store:
                 continue
             if record is not None:
                 records.append(record)
+                conditions.append(run.condition.columns())
         if corrupt:
             print(
                 f"ignoring {len(corrupt)} corrupt result file(s) (rerun the experiment to recompute them): "
                 + summarise(corrupt),
                 file=sys.stderr,
             )
-        return pd.DataFrame.from_records(records)
+        table = pd.DataFrame.from_records(records)
+        typed = pd.DataFrame(conditions, index=table.index, dtype=object)  # N stays an int beside a missing N
+        return pd.concat([table, typed], axis=1) if len(typed.columns) else table
 
 
 class CorruptRecord(ValueError):
