@@ -17,7 +17,7 @@ from replication.paths import CONF_DIR, resolve
 from replication.report.index import write_index
 from replication.report.published import load_published
 from replication.report.render import ENVIRONMENT, browser, open_in_browser
-from replication.report.summary import experiment_configs, summary_table
+from replication.report.summary import counts, experiment_configs, summary_table
 from replication.report.tables import KEYS, TableKind
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
@@ -90,7 +90,9 @@ def test_summary_has_one_row_per_published_cell_with_ours_or_a_reason(published)
     assert reasons[5].startswith("private video, no stand-in: soccer (real soccer video (not public))")
     assert reasons[6] == "no value in the paper: failed (reported as error)"
     assert reasons[7].startswith("not yet replicated")
-    assert reasons[8].startswith("not run at this scale (quick)")
+    assert reasons[8] == "not run at this scale: trk at scale=paper (ran at quick)"
+    assert list(table["reason_kind"])[1:4] == ["method not reproduced", "condition not reproduced", "not run yet"]
+    assert counts(table)["reasons"]["not run yet"] == 1  # counted by kind, not by cutting the text at a colon
     assert table.iloc[8]["link"] == "trk/index.html#unmatched"
     assert all(bool(v) != bool(r) for v, r in zip(table["verdict"], table["reason"]))  # one or the other
 

@@ -12,6 +12,7 @@ replicated at all.
 
 import json
 from collections import Counter
+from dataclasses import dataclass
 import sys
 from pathlib import Path
 
@@ -84,7 +85,7 @@ def summary_table(
         found = by_key.get(key, [])
         row = {k: cell[k] for k in KEYS}
         row.update(note=cell["note"], paper_value=_paper_value(cell), ours="", outcome="", verdict="", tag="",
-                   reason="", also="", our_condition="", runs="", link="", link_text="",
+                   reason="", reason_kind="", also="", our_condition="", runs="", link="", link_text="",
                    claim=claims[index] if claims else "")
         if found:
             name, summary, entry = found[0]
@@ -103,11 +104,13 @@ def summary_table(
                 for _, _, e in found[1:]
             )
         else:
-            row["reason"], name = _why_not(cell, summaries, configs, scene_notes)
+            unmatched, name = _why_not(cell, summaries, configs, scene_notes)
+            row["reason"], row["reason_kind"] = str(unmatched), unmatched.kind
             row["link"] = f"{name}/index.html#unmatched" if name in summaries else ""
             row["link_text"] = name if name in summaries else ""
         rows.append(row)
     columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "tag", "reason",
+               "reason_kind",
                "also", "claim", "link", "link_text"]
     return pd.DataFrame(rows, columns=columns)
 
@@ -118,7 +121,7 @@ def counts(table: pd.DataFrame, summaries: dict[str, dict] | None = None) -> dic
     other tolerance (``sensitivity``: {'as configured' or '+-5%': {outcome: count}})."""
     compared = table[table["verdict"] != ""]
     verdicts = compared["outcome"].value_counts()
-    reasons = table[table["reason"] != ""]["reason"].map(lambda r: r.split(":")[0]).value_counts()
+    reasons = table[table["reason_kind"] != ""]["reason_kind"].value_counts()
     moved, seen = {}, set()
     for summary in (summaries or {}).values():  # the first entry of each cell, as summary_table shows it
         for entry in summary.get("cells", []):
@@ -187,36 +190,49 @@ def _covering(cell: pd.Series, configs: dict[str, dict]) -> list[tuple[str, dict
     return found
 
 
-def _why_not(cell: pd.Series, summaries: dict, configs: dict, scene_notes: dict) -> tuple[str, str]:
+@dataclass(frozen=True)
+class Unmatched:
+    """Why a published cell was not compared: its kind ('not run yet', 'scene not reproduced', ...: what
+    the index counts) and the detail a reader needs."""
+
+    kind: str
+    detail: str
+
+    def __str__(self) -> str:
+        return f"{self.kind}: {self.detail}"
+
+
+def _why_not(cell: pd.Series, summaries: dict, configs: dict, scene_notes: dict) -> tuple[Unmatched, str]:
     """Why no table of ours matched ``cell``, and the experiment the reason is about ('' if none)."""
     if not str(cell["value"]):
-        return f"no value in the paper: {cell['note'] or 'cell empty'}", ""
+        return Unmatched("no value in the paper", cell["note"] or "cell empty"), ""
     covering = _covering(cell, configs)
     if not covering:
-        return f"not yet replicated: no table of ours covers {cell['paper']} table {cell['table']}", ""
+        return Unmatched("not yet replicated", f"no table of ours covers {cell['paper']} table {cell['table']}"), ""
     ran = [(name, spec) for name, spec in covering if name in summaries]
     name, spec = (ran or covering)[0]
     config = configs[name]
     if cell["method"] not in config.get("methods", {}):
-        return f"method not reproduced: {cell['method']} is not among {name}'s methods", name
+        return Unmatched("method not reproduced", f"{cell['method']} is not among {name}'s methods"), name
     wanted = [m if isinstance(m, dict) else {"condition": m} for m in spec.get("match", {}).values()]
     scenes = {str(m["experiment"]) for m in wanted if "experiment" in m}
     if scenes and cell["experiment"] not in scenes:
         note = scene_notes.get((cell["paper"], cell["experiment"]), "")
         private = any(word in note.lower() for word in ("not public", "private"))
         what = "private video, no stand-in" if private else "scene not reproduced"
-        return f"{what}: {cell['experiment']}{f' ({note})' if note else ''}", name
+        return Unmatched(what, f"{cell['experiment']}{f' ({note})' if note else ''}"), name
     conditions = {str(m["condition"]) for m in wanted if "condition" in m}
     stated = cell["condition"] or spec.get("paper_condition", "")
     if conditions and stated not in conditions:
-        return f"condition not reproduced: {stated or 'unstated'}", name
+        return Unmatched("condition not reproduced", stated or "unstated"), name
     if name not in summaries:
-        return f"not run yet: experiment={name}", name
+        return Unmatched("not run yet", f"experiment={name}"), name
     summary = summaries[name]
     if "cells" not in summary:  # written before reports listed the cells they matched
-        return f"see {name}'s page: its summary.json lists no cells (python -m replication.report)", name
+        return Unmatched("written before reports listed their cells",
+                         f"see {name}'s page, or python -m replication.report"), name
     if not summary.get("n_records"):
-        return f"not run yet: no stored runs of {name}", name
+        return Unmatched("not run yet", f"no stored runs of {name}"), name
     if summary.get("scale") != "paper":
-        return f"not run at this scale ({summary.get('scale')}): {name} at scale=paper", name
-    return f"not matched: no row of {name} met this cell (see its page)", name
+        return Unmatched("not run at this scale", f"{name} at scale=paper (ran at {summary.get('scale')})"), name
+    return Unmatched("not matched", f"no row of {name} met this cell (see its page)"), name
