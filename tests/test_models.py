@@ -111,3 +111,38 @@ def test_kalman_log_evidence_is_the_joint_gaussian_density_of_the_observations()
     cov_z = model.c**2 * cov_x + model.R * np.eye(model.steps)
     exact = multivariate_normal(model.c * model.a**t * model.x0, cov_z).logpdf(observations)
     assert kalman_filter(model, observations)[2] == pytest.approx(exact, rel=1e-10)
+
+
+def test_a_fixed_size_box_keeps_the_first_box_size_whatever_the_noise():
+    from replication.models.box import BoxModel
+
+    rng = np.random.default_rng(0)
+    model = BoxModel(np.array([50.0, 40.0, 20.0, 20.0]), None, kind="constant_velocity", size="fixed",
+                     step_sd=(0.0, 0.0, 0.5, 0.5), initial_sd=(1.0, 1.0, 0.5, 0.5))
+    particles = model.sample_initial(200, rng)
+    for t in range(1, 300):
+        particles = model.propagate(particles, t, rng)
+    assert (particles[:, 2:4] == 20.0).all() and particles[:, :2].std() > 1.0  # the centre moves, the size not
+    drifting = BoxModel(np.array([50.0, 40.0, 20.0, 20.0]), None, kind="constant_velocity",
+                        step_sd=(0.0, 0.0, 0.5, 0.5))
+    assert drifting.propagate(drifting.sample_initial(200, rng), 1, rng)[:, 2:4].std() > 0.1
+    with pytest.raises(ValueError, match="unknown size"):
+        BoxModel(np.ones(4), None, size="shrinking")
+
+
+def test_bis_pf_tracks_the_balls_with_boxes_of_their_size():
+    """Issue 30: the boxes of every filter on bis_pf's ball scenes stay 20x20 (they drifted to 57 px^2)."""
+    from hydra import compose, initialize_config_dir
+
+    from replication.paths import CONF_DIR
+    from replication.runner.config import expand
+    from replication.tasks import TASKS
+
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=["experiment=bis_pf", "scale=quick",
+                                           "experiment.scenes.exp2_16_targets.frames.quick=30"])
+    runs = expand(cfg)
+    assert {r.model["motion"]["size"] for r in runs} == {"fixed"}
+    run = next(r for r in runs if r.method == "BIS-PF" and r.condition.get("scene") == "exp2_16_targets")
+    boxes = np.asarray(TASKS[run.task].run(run)["per_frame"]["box"], dtype=float)
+    assert boxes.shape[1] == 16 and (boxes[..., 2:4] == 20.0).all()

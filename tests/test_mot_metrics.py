@@ -99,3 +99,27 @@ def test_sort_keeps_ids_over_a_gap_shorter_than_max_age_and_births_after_min_hit
 def test_detections_only_links_neighbours_and_restarts_after_a_gap():
     tracks = detections_only(walker_detections(missing=(8,)))
     assert tracks.groupby("id")["frame"].agg(["min", "max"]).values.tolist() == [[1, 7], [1, 20], [9, 20]]
+
+
+def test_the_three_errors_of_two_balls_that_swap():
+    """Two balls 40 px apart whose estimates swap at frame 5 (hand case): the per-identity error is 40 px
+    from then on, the identity-free error and OSPA stay 0, and the error while tracked counts only the
+    frames before each loss; one close encounter when they pass within 20 px."""
+    from replication.metrics import multi
+
+    truth = np.zeros((10, 2, 2))
+    truth[:, 1, 0] = 40.0
+    estimates = truth.copy()
+    estimates[5:] = truth[5:, ::-1]
+    assert multi.mean_error_per_target(estimates, truth) == 20.0  # 40 px in half of the frames
+    assert multi.identity_free_error(estimates, truth) == 0.0
+    assert multi.ospa(estimates, truth, cutoff=20.0) == 0.0
+    onsets = multi.loss_onsets(estimates, truth, threshold=20.0, patience=3)
+    assert list(onsets) == [5, 5] and multi.track_losses(estimates, truth, 20.0, 3).all()
+    assert multi.tracked_error(estimates, truth, onsets) == 0.0
+    off = truth + np.array([30.0, 0.0])  # 30 px right of its own ball: the first 10 px from the second ball
+    # the best assignment crosses: (10 + min(70, 20)) / 2 = 15, against (min(30, 20) + min(30, 20)) / 2 = 20
+    assert multi.ospa(off, truth, cutoff=20.0) == pytest.approx(15.0)
+    passing = truth.copy()
+    passing[3:6, 1, 0] = 10.0  # ball 2 comes within 20 px for frames 3-5, once
+    assert multi.close_encounters(passing, 20.0) == 1 and multi.close_encounters(truth, 20.0) == 0

@@ -54,9 +54,14 @@ QUANTITIES = {
     "mean_cle": Quantity("positive", label="mean centre location error (px)"),
     "visible_error": Quantity("positive", label="mean error while visible (px)"),
     "mean_error_per_target": Quantity("positive", label="mean error per target (px)"),
+    "identity_free_error": Quantity("positive", label="identity-free error per target (px)"),
+    "tracked_error": Quantity("positive", label="error per target while tracked (px)"),
+    "encounters": Quantity("positive", label="close encounters"),
+    "swaps_per_encounter": Quantity("positive", label="identity switches per close encounter"),
     "lost_targets": Quantity("positive", label="targets lost"),
     "switches": Quantity("positive", label="identity switches"),
     "degenerate_steps": Quantity("positive", label="degenerate steps"),
+    "outside_frames": Quantity("positive", label="estimates outside the image (target-frames)"),
     "resample_count": Quantity("positive", label="resamplings"),
     "mean_ess": Quantity("positive", lower_is_better=False, label="mean ESS (particles)"),
     "resample_rate": Quantity("bounded", 0.0, 100.0, label="resampling rate (%)"),
@@ -91,6 +96,7 @@ _PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_t
     (re.compile(r"correct_frames\[(.+)\]"), lambda rule: replace(_SHARE, label=f"share of frames with {rule}")),
     (re.compile(r"tracked_to_end\[(.+)\]"), lambda rule: replace(_BINARY, lower_is_better=False,
                                                                  label=f"runs tracked to the end ({rule})")),
+    (re.compile(r"ospa\[c=(.+)\]"), lambda cutoff: Quantity("positive", label=f"OSPA, cut off at {cutoff} px")),
 )
 
 

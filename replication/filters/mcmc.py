@@ -13,7 +13,14 @@ As pinned in baselines.md §2.  Each frame:
    the chain then targeting the joint of (X'_i, r') (an auxiliary-variable MH);
 3. keep the N states after burn-in (equal weights): the estimate is their mean;
    the ``carry`` (10 in bis_pf) best of them by likelihood times potentials
-   (tracked incrementally; the predictive prior is not scored) go to the next frame.
+   (tracked incrementally; the predictive prior is not scored) go to the next frame
+   (a carry of N or more: all of them, Khan et al.'s predictive mixture).
+
+Carrying the 10 best is near-MAP: with the noise on the velocity (gps_qmcpf eq 14)
+a ball's next velocity is then corrected by twice its position's correction
+(x' = x + v + a/2, v' = v + a), a tracker on the edge of stability whose
+velocity noise walks away, off the image on still balls (tests/test_bis.py);
+carrying all samples, or the noise on the position, keeps it on them.
 
 The proposals do not depend on the chain, so all of a frame's proposals and
 their likelihoods are drawn in one vectorised pass per target; the chain itself

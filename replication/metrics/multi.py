@@ -1,4 +1,5 @@
-"""Multi-target metrics: mean error per target (bis_pf), track loss, CLEAR MOT and IDF1.
+"""Multi-target metrics: mean error per target (bis_pf) and its identity-free and while-tracked
+readings, OSPA, close encounters, track loss, CLEAR MOT and IDF1.
 
 Ground truth and hypotheses are centre tracks: ``truth`` (T, M, 2) with a
 presence mask (T, M), ``estimates`` (T, K, 2) with a presence mask (T, K).
@@ -26,15 +27,58 @@ def mean_error_per_target(estimates: np.ndarray, truth: np.ndarray) -> float:
     return float(np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1).mean())
 
 
-def track_losses(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
-    """(M,) bool: target m is lost when its estimate stays over ``threshold`` px away for ``patience`` frames."""
+def identity_free_error(estimates: np.ndarray, truth: np.ndarray) -> float:
+    """The error with identities left out: in each frame, the estimates assigned to the truths by minimum
+    total distance (Hungarian, :func:`scipy.optimize.linear_sum_assignment`), the mean matched distance
+    over frames and targets.  Two estimates that swap balls keep a small error here."""
+    d = _pairwise(estimates, truth)
+    return float(np.mean([d[k][linear_sum_assignment(d[k])].mean() for k in range(len(d))]))
+
+
+def ospa(estimates: np.ndarray, truth: np.ndarray, cutoff: float, order: int = 1) -> float:
+    """Mean over frames of the OSPA distance (Schuhmacher, Vo and Vo 2008) between equally many estimates
+    and truths: (min over assignments of the mean of min(d, ``cutoff``)^p)^(1/p)."""
+    d = np.minimum(_pairwise(estimates, truth), cutoff) ** order
+    return float(np.mean([d[k][linear_sum_assignment(d[k])].mean() ** (1 / order) for k in range(len(d))]))
+
+
+def _pairwise(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    """(T, M, M): distance from estimate i to truth j in each frame."""
+    return np.linalg.norm(np.asarray(estimates)[:, :, None, :] - np.asarray(truth)[:, None, :, :], axis=-1)
+
+
+def close_encounters(truth: np.ndarray, distance: float) -> int:
+    """How many times two truths come within ``distance`` of each other (a pair's run of close frames counts
+    once): the occasions for an identity swap."""
+    d = _pairwise(truth, truth)
+    close = (d < distance) & ~np.eye(d.shape[1], dtype=bool)
+    starts = close[1:] & ~close[:-1]
+    return int(np.triu(starts, k=1).sum() + np.triu(close[0], k=1).sum())
+
+
+def loss_onsets(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
+    """(M,) the frame at which each target's first loss begins (the first of ``patience`` frames in a row
+    over ``threshold`` px from it), or the number of frames for a target never lost."""
     far = np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1) > threshold
     run = np.zeros(far.shape[1], dtype=int)
-    lost = np.zeros(far.shape[1], dtype=bool)
-    for row in far:
+    onset = np.full(far.shape[1], len(far))
+    for k, row in enumerate(far):
         run = np.where(row, run + 1, 0)
-        lost |= run >= patience
-    return lost
+        onset = np.where((run >= patience) & (onset == len(far)), k - patience + 1, onset)
+    return onset
+
+
+def track_losses(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
+    """(M,) bool: target m is lost when its estimate stays over ``threshold`` px away for ``patience`` frames."""
+    return loss_onsets(estimates, truth, threshold, patience) < len(estimates)
+
+
+def tracked_error(estimates: np.ndarray, truth: np.ndarray, onsets: np.ndarray) -> float:
+    """The error while tracked: the mean per-identity error over each target's frames before its first loss
+    (``onsets``: :func:`loss_onsets`); NaN when every target is lost at once."""
+    errors = np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1)
+    before = np.arange(len(errors))[:, None] < np.asarray(onsets)[None, :]
+    return float(errors[before].mean()) if before.any() else float("nan")
 
 
 def _distances(truth_k, estimates_k, threshold):

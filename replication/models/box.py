@@ -13,7 +13,10 @@ the velocities vx, vy.  Motions:
   velocity disturbed by Gaussian noise ... a random walk", read as noise on
   position); v starts at 0, so the centre then takes a random walk.
 
-Sizes are kept at least ``min_size`` px.  The observation is an image; the
+Sizes take a random walk (``size: drifting``) and are kept at least
+``min_size`` px, or keep the first box's (``size: fixed``: no size noise,
+whatever ``step_sd`` and ``initial_sd`` give the size; bis_pf's 20x20 balls).
+The observation is an image; the
 likelihood is a :class:`replication.vision.ColourLikelihood` (or any object
 with ``prepare(frame)`` and ``log_likelihood(boxes, prepared)``).
 """
@@ -25,6 +28,7 @@ import numpy as np
 
 MOTIONS = ("random_walk", "constant_velocity")
 NOISE_ON = ("velocity", "position")  # where a constant-velocity model's disturbance enters
+SIZES = ("drifting", "fixed")  # whether the box's width and height move
 
 
 @dataclass
@@ -38,6 +42,7 @@ class BoxModel:
     accel_sd: float = 1.0  # constant velocity: sd of the acceleration, px / frame^2
     period: float = 1.0  # T of gps_qmcpf eq (14)
     noise_on: str = "velocity"  # constant velocity: the disturbance accelerates (eq 14) or displaces the centre
+    size: str = "drifting"  # fixed: the first box's width and height throughout
     initial_sd: tuple[float, float, float, float] = (2.0, 2.0, 0.5, 0.5)
     min_size: float = 2.0
     cache: dict = field(default_factory=dict, repr=False)  # frame features; shared by a run's targets
@@ -51,6 +56,10 @@ class BoxModel:
         self.initial_box = np.asarray(self.initial_box, dtype=float)
         self.step_sd = np.asarray(self.step_sd, dtype=float)
         self.initial_sd = np.asarray(self.initial_sd, dtype=float)
+        if self.size not in SIZES:
+            raise ValueError(f"unknown size {self.size!r}; choose one of {SIZES}")
+        if self.size == "fixed":
+            self.step_sd[2:4] = self.initial_sd[2:4] = 0.0
         if (self.step_sd < 0).any() or (self.initial_sd < 0).any() or self.accel_sd < 0:
             raise ValueError("noise standard deviations must be non-negative")
         self.dim = 4 if self.kind == "random_walk" else 6

@@ -25,6 +25,8 @@ UNDEFINED = {  # metric: when it is undefined, and so stored as NaN (or inf) wit
     "motp": "MOT: no hypothesis matched a target",
     "mean_error_per_target": "MOT: no hypothesis matched a target",
     "fps": "MOT: a tracker timed at 0 s runs at infinitely many frames per second",
+    "swaps_per_encounter": "tracking: no two targets came within a box width of each other",
+    "tracked_error": "tracking: every target was lost from the first frame judged",
 }
 FAILED_STATUS = 3  # the run command's exit status when runs failed (2: a bad request; 130, 143: interrupted)
 SHOWN = 3  # numbers named in a reason
