@@ -357,3 +357,15 @@ def test_tab_completion_offers_experiments_and_keys():
     assert complete("pf-replicate experiment=hspf_u") == ["experiment=hspf_ungm", "experiment=hspf_ungm_sweep"]
     assert "scale=" in complete("pf-replicate experiment=hspf sc")
 
+
+
+def test_a_table_whose_scene_is_not_run_is_named_before_any_work(make_cfg):
+    """Issue 30: bis_pf without its 3123 scene says, before running, which tables it leaves out."""
+    from replication.runner.validate import prepare
+
+    _, skipped, _ = prepare(make_cfg("bis_pf", "scale=quick", "experiment.model.sweep.scene=[exp2_16_targets]"))
+    named = [line for line in skipped if "table" in line]
+    assert named == ["bis_pf: table modes_3123 needs scene=exp1_3123, which no run of this request has: its page "
+                     "will leave it out"]  # table3_stability matches 16 balls too: it stays
+    _, everything, _ = prepare(make_cfg("bis_pf", "scale=quick"))
+    assert not [line for line in everything if "table" in line]

@@ -141,4 +141,14 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
         why = "; ".join(s.removeprefix(f"{cfg.experiment.name}: ").removesuffix(": skipped") for s in skipped)
         why = f": {why}" if why else ""
         raise ConfigError(f"{cfg.experiment.name}: nothing to run (every condition was skipped{why})")
-    return runs, skipped, settings
+    return runs, skipped + tables_without_runs(cfg, runs), settings
+
+
+def tables_without_runs(cfg: DictConfig, runs: list[Run]) -> list[str]:
+    """A line for each report table whose conditions (the keys of its ``match:``) no run of this request
+    has (bis_pf run without its 3123 scene): said before any work, the page then leaves the table out."""
+    tables = OmegaConf.to_container(cfg.experiment, resolve=True).get("report", {}).get("tables", [])
+    ran = {str(run.condition) for run in runs}
+    return [f"{cfg.experiment.name}: table {spec['name']} needs {' or '.join(spec['match'])}, which no run of "
+            f"this request has: its page will leave it out" for spec in tables
+            if spec.get("match") and not ran & set(spec["match"])]
