@@ -52,7 +52,7 @@ def values_of(records: pd.DataFrame, variable: str | None) -> pd.Series:
     """The value of ``variable`` in each row of ``records`` (None where a row's condition lacks it, and in
     every row for no variable)."""
     column = f"{PREFIX}{variable}"
-    if column not in records:
+    if variable is None or column not in records:
         return pd.Series([None] * len(records), index=records.index, dtype=object)
     return records[column].astype(object).where(records[column].notna(), None)
 

@@ -54,8 +54,8 @@ class BoxModel:
         if self.noise_on not in NOISE_ON:
             raise ValueError(f"unknown noise_on {self.noise_on!r}; choose one of {NOISE_ON}")
         self.initial_box = np.asarray(self.initial_box, dtype=float)
-        self.step_sd = np.asarray(self.step_sd, dtype=float)
-        self.initial_sd = np.asarray(self.initial_sd, dtype=float)
+        self.step_sd = np.array(self.step_sd, dtype=float)  # copies: a fixed size zeroes their size entries
+        self.initial_sd = np.array(self.initial_sd, dtype=float)
         if self.size not in SIZES:
             raise ValueError(f"unknown size {self.size!r}; choose one of {SIZES}")
         if self.size == "fixed":

@@ -72,7 +72,8 @@ def source_of(code) -> str:
     return Path(inspect.getsourcefile(code)).resolve().relative_to(PACKAGE).as_posix()
 
 
-def _imports(relative: str, package: Path) -> set[str]:
+@lru_cache(maxsize=1024)
+def _imports(relative: str, package: Path) -> frozenset[str]:
     """The package's source files that importing ``relative`` runs: the modules it imports (anywhere in it,
     functions included) and the ``__init__.py`` of every package on their way."""
     tree = ast.parse((package / relative).read_text(), relative)
@@ -96,7 +97,7 @@ def _imports(relative: str, package: Path) -> set[str]:
                 if (package / candidate).is_file():
                     files.add(candidate.as_posix())
     files.add("__init__.py")
-    return files
+    return frozenset(files)
 
 
 @lru_cache(maxsize=1)
