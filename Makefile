@@ -57,7 +57,7 @@ test-all: setup browser
 replicate: setup
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
 	$(BIN)/python benchmarks/benchmark.py
-	$(BIN)/python -m replication.report.calibration
+	$(BIN)/python -m replication.report.pages.calibration
 	$(BIN)/python -m replication.report.pdf
 
 readings: setup
@@ -71,7 +71,7 @@ report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)
 
 calibrate: setup
-	$(BIN)/python -m replication.report.calibration
+	$(BIN)/python -m replication.report.pages.calibration
 
 docs: setup
 	$(BIN)/python -m pdoc -o reports/api replication

@@ -46,8 +46,8 @@ import pandas as pd  # noqa: E402
 from replication.filters import PointMassFilter, bootstrap  # noqa: E402
 from replication.models import UNGM  # noqa: E402
 from replication.paths import resolve  # noqa: E402
-from replication.report.index import write_index  # noqa: E402
-from replication.report.render import html_table, render  # noqa: E402
+from replication.report.pages.index import write_index  # noqa: E402
+from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.runner.memory import retain_freed_memory  # noqa: E402
 from replication.scenes import SyntheticScene  # noqa: E402
 from replication.smc.resampling import RESAMPLERS  # noqa: E402

@@ -148,8 +148,8 @@ def run_experiment(cfg: DictConfig) -> None:
         done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
         stored = len(runs) - done
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}")
-        from replication.report.experiment import write_experiment_report
-        from replication.report.index import write_index
+        from replication.report.pages.experiment import write_experiment_report
+        from replication.report.pages.index import write_index
 
         written = write_experiment_report(cfg, runs, store)
         index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
@@ -185,8 +185,8 @@ def run_multiverse(cfg: DictConfig) -> None:
             store, runs = Store(resolve(cfg.store), experiment), multiverse.runs_of(experiment)
             done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
             print(f"{name}: {experiment}: {done} runs computed, {len(runs) - done} already stored")
-        from replication.report.index import write_index
-        from replication.report.multiverse import write_multiverse_report
+        from replication.report.pages.index import write_index
+        from replication.report.pages.multiverse import write_multiverse_report
 
         written = write_multiverse_report(cfg, multiverse)
         index = write_index(resolve(cfg.reports), cfg.published_values)

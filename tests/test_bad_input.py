@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import PROJECT_ROOT
 
-from replication.report import summary
+from replication.evidence import summary
 from replication.scenes.otb import OTB_ROOT
 
 # Runs the command line in-process and prints, on exit, whether numpy had been imported by then.

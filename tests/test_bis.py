@@ -208,8 +208,8 @@ def test_mcmc_potential_keeps_two_targets_apart():
 def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     from conftest import SMALL
 
-    from replication.report.published import load_published
-    from replication.report.tables import Rating
+    from replication.evidence.published import load_published
+    from replication.evidence.tables.rating import Rating
     from replication.runner.config import expand
     from replication.runner.execute import execute
     from replication.runner.store import Store

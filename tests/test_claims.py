@@ -11,8 +11,8 @@ from conftest import typed
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
-from replication.report.claims import Check, ClaimTest, Result, load_papers
-from replication.report.published import load_published
+from replication.evidence.claims import Check, ClaimTest, Result, load_papers
+from replication.evidence.published import load_published
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 PAPERS = load_papers()
@@ -161,7 +161,7 @@ def test_result_combines_checks():
 
 
 def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
-    from replication.report.tables import Rating
+    from replication.evidence.tables.rating import Rating
 
     published = pd.DataFrame({"paper": ["p"], "table": ["3"], "experiment": ["s"], "method": ["A"],
                               "metric": ["stability"], "condition": [""], "value": ["good"], "unit": [""],

@@ -10,9 +10,10 @@ from matplotlib.colors import to_hex
 from conftest import typed
 
 from replication.paths import CONF_DIR, resolve
-from replication.report import figures, tracking_figures
-from replication.report.published import load_published
-from replication.report.style import (
+from replication.report import figures
+from replication.report.figures import metric as metric_figures, tracking as tracking_figures
+from replication.evidence.published import load_published
+from replication.report.figures.style import (
     METHODS, PALETTE, NothingToDraw, axis_label, clip_diverged, method_look,
 )
 
@@ -28,7 +29,7 @@ PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" +
 @pytest.fixture
 def drawn(keep_figures):
     """The figures drawn, as matplotlib Figures (instead of PNG files)."""
-    return keep_figures(figures, tracking_figures)
+    return keep_figures(metric_figures, tracking_figures)
 
 
 def _scalar_records(values: dict[tuple[str, str], list[float]]) -> pd.DataFrame:
@@ -194,6 +195,6 @@ def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypa
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):
         tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
     seen = []
-    monkeypatch.setattr(figures, "_figures", lambda: {"probe": lambda r, s, e, p: seen.append(sorted(r["condition"])) or p})
+    monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
     figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")
     assert seen == [["scene=b"]]

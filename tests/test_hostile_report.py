@@ -7,7 +7,7 @@ import sys
 import pytest
 from conftest import PROJECT_ROOT
 
-from replication.report.render import browser, open_in_browser
+from replication.report.pages.render import browser, open_in_browser
 
 # Each sets an attribute on the page if it ever runs; the dumped DOM would carry it.
 # (no quotes inside: they go through Hydra's quoted override strings as they are)

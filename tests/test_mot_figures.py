@@ -14,9 +14,9 @@ from conftest import typed
 
 from replication.filters.mot_baselines import detections_only, sort
 from replication.metrics.mot import clear_mot_matches, drop_ignored, mot_metrics
-from replication.report import mot_figures
+from replication.report.figures import mot as mot_figures
 from replication.report.figures import draw
-from replication.report.render import render
+from replication.report.pages.render import render
 from replication.scenes import load_mot
 from replication.tasks.mot import frame_table
 

@@ -9,8 +9,8 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.report.claims import Claim, Reading, load_papers
-from replication.report.multiverse import READING, Case, Robustness, write_multiverse_report
+from replication.evidence.claims import Claim, Reading, load_papers
+from replication.report.pages.multiverse import READING, Case, Robustness, write_multiverse_report
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
@@ -178,7 +178,7 @@ def test_every_multiverse_config_loads_with_its_defaults_equal_to_the_experiment
 def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiverse():
     import pandas as pd
 
-    from replication.report.scorecard import claim_rows, claims_frame
+    from replication.evidence.scorecard import claim_rows, claims_frame
 
     papers = [p for p in load_papers() if p.key == "hspf"]
     cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED, per_run=RUNS),

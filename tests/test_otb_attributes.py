@@ -10,8 +10,9 @@ import pytest
 from conftest import typed
 
 from replication.metrics import tracking as tm
-from replication.report import figures, tracking_figures
-from replication.report.tables import TableKind
+from replication.report import figures
+from replication.report.figures import metric as metric_figures, tracking as tracking_figures
+from replication.evidence.tables import TableKind
 from replication.scenes.otb import otb_attributes
 
 # Suv carries OCC, IPR and OV; Girl SV, OCC, IPR and OPR (OTB-100's list).  The scene keys are ours.
@@ -103,7 +104,7 @@ def test_no_listed_sequence_gives_an_empty_table_and_every_listed_code_is_an_att
 
 
 def test_attribute_map_shows_each_method_per_attribute_and_frames_the_best(keep_figures, tmp_path):
-    drawn = keep_figures(figures, tracking_figures)
+    drawn = keep_figures(metric_figures, tracking_figures)
     figures.draw(hand_records(), {"kind": "attribute_map", "name": "m"}, EXPERIMENT, tmp_path / "m.png")
     precision = drawn[0].axes[0]
     assert [t.get_text() for t in precision.get_xticklabels()] == ["SV\nGirl", "OCC\n2 seq.", "IPR\n2 seq.",

@@ -184,7 +184,7 @@ def test_exported_results_rescored_by_the_toolkit(exported, toolkit_otb, monkeyp
 
 
 def test_the_experiment_report_exports_runs_on_otb_sequences(exported):
-    from replication.report.experiment import write_experiment_report
+    from replication.report.pages.experiment import write_experiment_report
 
     page = write_experiment_report(exported.cfg, exported.runs, exported.store)
     assert 'href="results/OTB2015/"' in page.read_text() and 'href="results/GOT-10k/"' in page.read_text()

@@ -2,7 +2,7 @@
 
 import pytest
 
-from replication.report.tables import excess_over_floor
+from replication.evidence.tables.comparison import excess_over_floor
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.store import Store

@@ -8,10 +8,11 @@ import pytest
 from conftest import typed
 
 from replication.evidence.verdict import Outcome
-from replication.report import figures, ranking_figures
-from replication.report.claims import ClaimTest, Result
+from replication.report import figures
+from replication.report.figures import ranking as ranking_figures
+from replication.evidence.claims import ClaimTest, Result
 from replication.evidence.ranking import held_out, rank, rankings
-from replication.report.tables import Table, TableKind
+from replication.evidence.tables import Table, TableKind
 
 SEQUENCES = [f"s{i}" for i in range(6)]
 

@@ -12,8 +12,8 @@ from replication.evidence.quantities import quantity
 from replication.evidence.statistics import estimate, mean, median, paired_difference, proportion
 from replication.errors import ConfigError
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict, judge_band, judge_value, stability_bands
-from replication.report.published import load_published
-from replication.report.tables import Comparison
+from replication.evidence.published import load_published
+from replication.evidence.tables.comparison import Comparison
 
 EXPERIMENT = {
     "paper": "gps_qmcpf",
@@ -197,7 +197,7 @@ def test_published_values_file_has_every_ungm_cell_we_report():
 
 
 def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
-    from replication.report.modes import two_mode_share
+    from replication.evidence.tables.modes import two_mode_share
 
     density = np.zeros((4, 10))  # 10 bins over [0, 100): bin centres 5, 15, ..., 95
     density[0, [2, 7]] = 0.5  # mass at 25 and 75: both hypotheses held
@@ -211,7 +211,7 @@ def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
 
 
 def test_scale_changes_lists_what_quick_changes_from_the_config():
-    from replication.report.scale import scale_changes, scale_note
+    from replication.report.pages.scale import scale_changes, scale_note
 
     config = {"quick_frames": {"paper": None, "quick": 100},  # a YAML anchor, not a setting
               "runs": {"paper": 100, "quick": 10},
@@ -224,7 +224,7 @@ def test_scale_changes_lists_what_quick_changes_from_the_config():
 
 def test_every_template_escapes_what_a_config_puts_in_a_page():
     """A title, label or note from a config is text: a <script> in it must not reach the page as markup."""
-    from replication.report.render import ENVIRONMENT, render
+    from replication.report.pages.render import ENVIRONMENT, render
 
     assert all(ENVIRONMENT.autoescape(name) for name in ENVIRONMENT.list_templates())
     page = render("base.html.j2", title="<script>alert(1)</script>")
@@ -236,7 +236,7 @@ def test_a_summary_table_is_written_as_numbers_and_read_back_to_the_same_page():
     the PDF (drawn from the CSV) show 'mean [low, high]'."""
     import io
 
-    from replication.report.tables import Table, TableKind
+    from replication.evidence.tables import Table, TableKind
 
     records = pd.DataFrame({"method": ["A"] * 6 + ["B"] * 6, "condition": [""] * 12,
                             "mota": [0.5, 0.6, 0.55, 0.52, 0.58, 0.61, 0.1, 0.2, 0.15, 0.12, 0.18, 0.11]})

@@ -14,11 +14,11 @@ from hydra import compose, initialize_config_dir
 
 from replication.evidence.quantities import quantity
 from replication.paths import CONF_DIR, resolve
-from replication.report.index import write_index
-from replication.report.published import load_published
-from replication.report.render import ENVIRONMENT, browser, open_in_browser
-from replication.report.summary import counts, experiment_configs, summary_table
-from replication.report.tables import KEYS, TableKind
+from replication.report.pages.index import write_index
+from replication.evidence.published import load_published
+from replication.report.pages.render import ENVIRONMENT, browser, open_in_browser
+from replication.evidence.summary import counts, experiment_configs, summary_table
+from replication.evidence.tables import KEYS, TableKind
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 CSV = (
@@ -247,7 +247,7 @@ def test_summary_in_the_index_covers_every_published_cell(reports):
 
 
 def test_claims_csv_has_one_row_per_claim_with_a_verdict_and_its_interval(reports):
-    from replication.report.claims import load_papers
+    from replication.evidence.claims import load_papers
 
     claims = pd.read_csv(reports / "claims.csv", keep_default_na=False)
     expected = [c.id for p in load_papers() for c in p.claims]
@@ -298,7 +298,7 @@ def _pdf_pages_and_text(path: Path) -> tuple[int, str | None]:
 def test_pdf_has_the_summary_then_every_table_and_figure(reports):
     path = reports / "replication.pdf"
     assert path.read_bytes().startswith(b"%PDF")
-    from replication.report.summary import load_summaries
+    from replication.evidence.summary import load_summaries
 
     summaries = load_summaries(reports)
     assert set(summaries) == {"gps_qmcpf", "hspf_ungm"}

@@ -2,7 +2,7 @@
 rebuild reports from stored runs only.
 
 ``python -m replication.report experiment=<name> sweep=<key>=v1,v2,... [metric=<column>]``
-instead draws a Hydra multirun's sweep of one config value (``replication.report.sweep``).
+instead draws a Hydra multirun's sweep of one config value (``replication.report.pages.sweep``).
 
 Nothing is run: each experiment's report is redrawn from the records in the
 store, ``reports/index.html`` links them under the summary of every published
@@ -17,9 +17,9 @@ from hydra import compose, initialize_config_dir
 
 from replication.errors import ConfigError, fail
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.report.experiment import write_experiment_report
-from replication.report.index import write_index
-from replication.report.multiverse import write_multiverse_report
+from replication.report.pages.experiment import write_experiment_report
+from replication.report.pages.index import write_index
+from replication.report.pages.multiverse import write_multiverse_report
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
@@ -79,7 +79,7 @@ def main(argv: list[str]) -> None:
         index = write_index(reports, cfg.published_values)
         print(f"index: {index}")
         if switches["screenshot"]:
-            from replication.report.render import browser, open_in_browser
+            from replication.report.pages.render import browser, open_in_browser
 
             if browser() is None:
                 print("screenshot: skipped, no Chromium on the PATH (apt-get install chromium)",
@@ -96,7 +96,7 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
     from omegaconf import OmegaConf
     from omegaconf.errors import OmegaConfBaseException
 
-    from replication.report.sweep import default_metric, parse_sweep, sweep_records, write_sweep_report
+    from replication.report.pages.sweep import default_metric, parse_sweep, sweep_records, write_sweep_report
     from replication.scales import at_scale
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):

@@ -30,13 +30,13 @@ import replication  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
-from replication.report.index import TITLE, default_published_values  # noqa: E402
-from replication.report.published import load_published  # noqa: E402
-from replication.report.claims import load_papers  # noqa: E402
-from replication.report.scale import PAPER_COMMAND, scale_note  # noqa: E402
-from replication.report.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
-from replication.report.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
-from replication.report.tables import Table  # noqa: E402
+from replication.report.pages.index import TITLE, default_published_values  # noqa: E402
+from replication.evidence.published import load_published  # noqa: E402
+from replication.evidence.claims import load_papers  # noqa: E402
+from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
+from replication.evidence.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
+from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
+from replication.evidence.tables import Table  # noqa: E402
 from replication.evidence.verdict import RULES  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
@@ -398,7 +398,7 @@ def main(argv: list[str]) -> None:
     if unknown or len(options) != len(argv):
         print("usage: python -m replication.report.pdf [reports=DIR] [published_values=CSV]", file=sys.stderr)
         raise SystemExit(2)
-    from replication.report.index import write_index
+    from replication.report.pages.index import write_index
 
     reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
     path = write_pdf(reports, options.get("published_values"))

@@ -1,7 +1,7 @@
 """The scorecard: each paper's claims with their verdicts, from the results the experiment reports stored.
 
 Each experiment's ``summary.json`` holds, under ``claims``, the result of
-every reading that names it (:func:`replication.report.claims.evaluate`).
+every reading that names it (:func:`replication.evidence.claims.evaluate`).
 Here they are gathered per claim: the primary reading's verdict, the number
 that decided it with its interval, one line of why, and whether the verdict
 survives the other readings.  ``reports/claims.csv`` is the same, one row
@@ -15,7 +15,7 @@ import pandas as pd
 
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
-from replication.report.claims import Claim, Paper, Reading
+from replication.evidence.claims import Claim, Paper, Reading
 
 
 @dataclass(frozen=True)

@@ -8,11 +8,13 @@ import numpy as np
 import pandas as pd
 
 from replication.evidence.ranking import rankings, unreliable
-from replication.report.style import OUTCOME_COLOURS, NothingToDraw, axis_label, save
+from replication.report.figures.style import OUTCOME_COLOURS, NothingToDraw, axis_label, save
+from replication.report.figures.base import figure
 
 LUMA = np.array([0.299, 0.587, 0.114])  # a colour's lightness: dark segments take white text
 
 
+@figure("ranking")
 def ranking(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """One row of two panels per ranking (:func:`~replication.evidence.ranking.rankings` of ``spec``):
     left, stacked bars of P(rank = k) per method, best first, with its P(best) and 95% rank interval;

@@ -9,17 +9,19 @@ import pandas as pd
 from matplotlib.colors import to_rgb
 
 from replication.evidence.aggregate import scene_of
-from replication.report.attributes import absent, attribute_scores
-from replication.report.style import (
+from replication.evidence.attributes import absent, attribute_scores
+from replication.report.figures.style import (
     NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
 )
 from replication.scenes.factory import cached_sequence
+from replication.report.figures.base import figure
 
 
 def _by_condition(records: pd.DataFrame):
     return list(records.groupby("condition", sort=False))
 
 
+@figure("per_frame_curve")
 def per_frame_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition;
     methods that do not record the series are left out.
@@ -78,6 +80,7 @@ def _sequence(experiment: dict, condition_records: pd.DataFrame):
     return cached_sequence(experiment["scenes"][name]), condition_records["per_frame"].iloc[0]["targets"]
 
 
+@figure("track")
 def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Centre x and y against the frame for the first run of each method, beside the truth."""
     groups = _by_condition(records)
@@ -110,6 +113,7 @@ def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
     return [k for k in frames if k < n_frames]
 
 
+@figure("snapshots")
 def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Snapshot grids, one block per condition; truth white edged in black, each method's first run in
     its colour.
@@ -161,6 +165,7 @@ def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, colour: st
     return image
 
 
+@figure("mode_strip")
 def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """The marginal posterior of one target over x or y, frame by frame (first run of each method),
     with every target's true coordinate drawn over it: does a hidden target keep both modes?"""
@@ -190,6 +195,7 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     return save(fig, path)
 
 
+@figure("otb_curves")
 def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """OTB one-pass precision and success plots over every sequence and run, one line per method.
 
@@ -219,6 +225,7 @@ def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     return save(fig, path)
 
 
+@figure("attribute_map")
 def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """OTB's per-attribute view as heat maps, methods down and attributes across: precision at 20 px,
     then success AUC, each the mean over the sequences carrying the attribute (under its code: how many,

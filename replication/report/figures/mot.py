@@ -26,9 +26,10 @@ from PIL import Image
 
 from replication.metrics.mot import BOX, clear_mot_matches
 from replication.condition import PREFIX, values_of
-from replication.report.style import method_label, save
+from replication.report.figures.style import method_label, save
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
 from replication.tasks.mot import frame_table
+from replication.report.figures.base import figure
 
 # tab10 then Dark2, both without their grey (kept for the ignore regions) and without light tints (which
 # would read as the white truth): 16 saturated colours, consecutive ids (mostly alive at the same time)
@@ -129,6 +130,7 @@ CAPTION = ("Coloured boxes: the tracker's output, one colour per track id (its n
            "white: ground truth; dashed grey: regions MOTChallenge ignores.")
 
 
+@figure("track_snapshots")
 def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Frames of the real video with each method's output (its first run), one row per method and condition,
     one column per frame of ``spec.frames`` (``{<scene key>: [MOT frame numbers]}`` or one list for every
@@ -187,6 +189,7 @@ def timeline_matches(sequence: MotSequence, run) -> tuple[pd.DataFrame, pd.DataF
     return truth, matches
 
 
+@figure("identity_timeline")
 def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Which output track held which person, frame by frame: one panel per method (its first run) and
     condition, one lane per ground-truth id, a bar in the matched track's colour (its id written in it)
@@ -314,6 +317,7 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
     return path
 
 
+@figure("track_video")
 def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """An animated GIF of one run, and a PNG poster as the figure: its first frame with an output box.
 

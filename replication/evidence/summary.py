@@ -1,7 +1,7 @@
 """Every published cell, one row each: ours beside it where a table of ours matched it, otherwise why not.
 
 Each experiment's ``summary.json`` lists, under ``cells``, the published cells
-its tables matched (:meth:`replication.report.tables.TableKind.entry` builds those entries); this module
+its tables matched (:meth:`replication.evidence.tables.TableKind.entry` builds those entries); this module
 joins them with ``published_values.csv`` so that the summary at the top of
 ``reports/index.html`` (and the PDF's first pages) has one row per published
 cell, in the file's order.  A cell that no experiment matched still has its
@@ -22,7 +22,7 @@ import yaml
 
 from replication.evidence.verdict import Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.report.tables import KEYS
+from replication.evidence.tables import KEYS
 
 # -- the summary of every published cell --------------------------------------------------------------
 

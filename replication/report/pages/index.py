@@ -1,9 +1,9 @@
 """``reports/index.html``: the scorecard of every paper's claims, every published cell against ours,
 then every experiment with a report, linked.
 
-The scorecard (:mod:`replication.report.scorecard`) is also written as
+The scorecard (:mod:`replication.evidence.scorecard`) is also written as
 ``reports/claims.csv``, and the summary of every published cell
-(:mod:`replication.report.summary`) as ``reports/summary.csv``.
+(:mod:`replication.evidence.summary`) as ``reports/summary.csv``.
 """
 
 import datetime
@@ -13,12 +13,12 @@ from omegaconf import OmegaConf
 
 import replication
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.report.claims import load_papers
-from replication.report.published import load_published
-from replication.report.render import render
-from replication.report.scale import scale_note
-from replication.report.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
-from replication.report.summary import counts, experiment_configs, load_summaries, summary_table
+from replication.evidence.claims import load_papers
+from replication.evidence.published import load_published
+from replication.report.pages.render import render
+from replication.report.pages.scale import scale_note
+from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
+from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table
 from replication.evidence.verdict import RULES
 
 TITLE = "Particle-filter tracking papers: replication report"

@@ -11,7 +11,7 @@ from jinja2 import Environment, PackageLoader, select_autoescape
 from markupsafe import Markup
 
 ENVIRONMENT = Environment(
-    loader=PackageLoader("replication.report", "templates"),
+    loader=PackageLoader("replication.report.pages", "templates"),
     autoescape=select_autoescape(["html", "htm", "xml", "html.j2"]),  # the templates are *.html.j2: escape every value
 )
 BROWSERS = ("chromium", "chromium-browser", "google-chrome", "chrome")

@@ -16,13 +16,13 @@ import replication
 from replication.evidence.verdict import RULES, Verdict
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
-from replication.report.claims import evaluate
+from replication.evidence.claims import evaluate
 from replication.report.figures import draw
-from replication.report.published import cells, load_published
-from replication.report.render import html_table, render
-from replication.report.scale import scale_changes, scale_note
-from replication.report.style import NothingToDraw
-from replication.report.tables import TableKind
+from replication.evidence.published import cells, load_published
+from replication.report.pages.render import html_table, render
+from replication.report.pages.scale import scale_changes, scale_note
+from replication.report.figures.style import NothingToDraw
+from replication.evidence.tables import TableKind
 from replication.run import Run
 from replication.runner.config import experiment_at_scale
 from replication.runner.results import frames, tidy, write

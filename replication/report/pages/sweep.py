@@ -17,8 +17,8 @@ import pandas as pd
 from replication.condition import PREFIX, label_of
 from replication.errors import ConfigError
 from replication.evidence.aggregate import summarise
-from replication.report.figures import metric_vs_condition
-from replication.report.render import html_table, render
+from replication.report.figures.metric import metric_vs_condition
+from replication.report.pages.render import html_table, render
 
 
 def parse_sweep(text: str) -> tuple[str, list[str]]:

@@ -27,12 +27,12 @@ from replication.evidence.inference import said_p
 from replication.evidence.robustness import DECISIVE, ChoiceEffect, adjust, paired_effect
 from replication.evidence.statistics import Estimate
 from replication.paths import resolve
-from replication.report.claims import Claim, ClaimTest, evaluate, load_papers
-from replication.report.published import load_published
-from replication.report.render import render
-from replication.report.scale import scale_note
-from replication.report.style import OUTCOME_COLOURS
-from replication.report.tables import TableKind
+from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
+from replication.evidence.published import load_published
+from replication.report.pages.render import render
+from replication.report.pages.scale import scale_note
+from replication.report.figures.style import OUTCOME_COLOURS
+from replication.evidence.tables import TableKind
 from replication.runner.multiverse import Multiverse
 from replication.runner.store import Store
 

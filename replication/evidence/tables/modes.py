@@ -8,7 +8,7 @@ counts as two-mode when at least ``mass`` of the marginal lies within
 ``width`` px of each hypothesis, in the frames of ``window`` where the two
 hypotheses are more than 2 ``width`` apart (before that they are one mode).
 A run keeps both modes when most of those frames do; a method does when
-most of its runs do (the table kind ``modes`` in :mod:`replication.report.tables`).
+most of its runs do (the table kind :class:`Modes`).
 The hypotheses come from the video each run saw (its ``scene_seed``).
 """
 
@@ -16,6 +16,9 @@ import numpy as np
 import pandas as pd
 
 from replication.evidence.aggregate import scene_of
+from replication.evidence.statistics import proportion
+from replication.evidence.tables.table import Table, TableKind, match
+from replication.evidence.verdict import judge_band
 from replication.scenes.factory import cached_sequence
 
 
@@ -47,3 +50,31 @@ def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -
         density = np.asarray(run["strip"]["density"])[first - 1 : last]
         shares.append(two_mode_share(density, hypotheses, sequence.size[axis], width, mass))
     return np.array(shares)
+
+
+class Modes(TableKind):
+    """Does a hidden target's posterior keep both hypotheses?  Runs that do, per method (bis_pf's 3123 text)."""
+
+    kind = "modes"
+    BANDS = {"success": (0.5, 1.0), "failure": (0.0, 0.5)}  # most runs keep both modes, or most do not
+
+    def build(self, records: pd.DataFrame) -> Table:
+        theirs = self.theirs()
+        stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
+        rows, entries = [], []
+        for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
+            shares = runs_keeping_both_modes(group, self.spec, self.experiment)
+            keeping = int((shares > 0.5).sum())
+            estimate = proportion(keeping, len(shares))
+            hit = match(theirs, method, condition, self.spec)
+            paper = hit["value"].iloc[0] if len(hit) else ""
+            ours = "success" if estimate.value > 0.5 else "failure"
+            verdict = judge_band(paper, keeping, len(shares), self.BANDS) if paper else None
+            row = {"method": self.label(method), "condition": condition or "-", "runs": len(shares),
+                   "two-mode frames (mean share)": round(float(shares.mean()), 3),
+                   "runs keeping both modes (Clopper-Pearson 95% CI)": str(estimate), "ours": ours, "paper": paper,
+                   "verdict": verdict}
+            rows.append(row)
+            entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
+        return Table(pd.DataFrame(rows), entries)
+

@@ -9,7 +9,7 @@ runs (``replication/evidence/calibration.py`` and what it imports) changes or
 more replications are asked for:
 ``make replicate`` reuses it.
 
-    python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]
+    python -m replication.report.pages.calibration [reports=DIR] [replications=N] [force=true]
 """
 
 import json
@@ -29,7 +29,7 @@ from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import ALPHA, detectable  # noqa: E402
 from replication.evidence.verdict import EQUIVALENCE_ALPHA  # noqa: E402
 from replication.paths import CONF_DIR, resolve  # noqa: E402
-from replication.report.render import html_table, render  # noqa: E402
+from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.runner.provenance import run_code_digest  # noqa: E402
 
 CSV = "calibration.csv"
@@ -139,7 +139,7 @@ def main(argv: list[str]) -> None:
     options = dict(a.split("=", 1) for a in argv if "=" in a)
     unknown = set(options) - {"reports", "replications", "force"}
     if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]",
+        print("usage: python -m replication.report.pages.calibration [reports=DIR] [replications=N] [force=true]",
               file=sys.stderr)
         raise SystemExit(2)
     reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)

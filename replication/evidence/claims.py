@@ -34,9 +34,9 @@ from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
 from replication.paths import CONF_DIR
 from replication.qmc import discrepancy_table
-from replication.report.published import cells as published_cells
+from replication.evidence.published import cells as published_cells
 from replication.evidence.ranking import rankings, unreliable
-from replication.report.tables import Table, match, pair
+from replication.evidence.tables import Table, match, pair
 
 CLAIMS_DIR = CONF_DIR / "claims"
 

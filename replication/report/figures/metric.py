@@ -15,15 +15,17 @@ from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from replication.condition import label_of, values_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
-from replication.report.published import COLUMNS, cells  # noqa: E402
-from replication.report.style import (  # noqa: E402
-    BLACK, PAPER, NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+from replication.evidence.published import cells  # noqa: E402
+from replication.report.figures.style import (  # noqa: E402
+    BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
     shades,
 )
+from replication.report.figures.base import figure  # noqa: E402
 
 PLAIN = FuncFormatter(lambda value, _: f"{value:g}")  # 0.1, 20, 500 rather than powers of ten
 
 
+@figure("metric_vs_condition")
 def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
                         published: pd.DataFrame | None = None) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
@@ -188,50 +190,3 @@ def _legend(ax) -> int:
         ax.legend(entries.values(), entries.keys(), fontsize=7, ncol=2, frameon=False, loc="upper center",
                   bbox_to_anchor=(0.5, -0.16))
     return (len(entries) + 1) // 2
-
-
-def _figures():
-    from replication.report.mot_figures import identity_timeline, track_snapshots, track_video
-    from replication.report.qmc_figures import point_sets
-    from replication.report.ranking_figures import ranking
-    from replication.report.tracking_figures import (
-        attribute_map, mode_strip, otb_curves, per_frame_curve, snapshots, track,
-    )
-
-    return {
-        "metric_vs_condition": metric_vs_condition,
-        "per_frame_curve": per_frame_curve,
-        "track": track,
-        "snapshots": snapshots,
-        "mode_strip": mode_strip,
-        "point_sets": point_sets,
-        "otb_curves": otb_curves,
-        "attribute_map": attribute_map,
-        "track_snapshots": track_snapshots,
-        "identity_timeline": identity_timeline,
-        "track_video": track_video,
-        "ranking": ranking,
-    }
-
-
-def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
-         published: pd.DataFrame | None = None) -> Path:
-    """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
-
-    A spec that names a ``paper_table`` gets the published values ``published``: the file the report was
-    asked to judge against, passed down once (none: no paper values on the figure).
-    A spec with ``conditions: [..]`` draws the runs of those conditions only.
-    """
-    figures = _figures()
-    if spec["kind"] not in figures:
-        raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(figures)}")
-    if "conditions" in spec:
-        records = records[records["condition"].isin(spec["conditions"])]
-        if records.empty:  # a scene the figure needs was not run (dropped by an override, say)
-            raise NothingToDraw(f"figure {spec.get('name', spec['kind'])!r}: no runs at conditions "
-                                f"{spec['conditions']}")
-    if "paper_table" not in spec:
-        return figures[spec["kind"]](records, spec, experiment, path)
-    if published is None:
-        published = pd.DataFrame(columns=COLUMNS + ["number"])
-    return figures[spec["kind"]](records, spec, experiment, path, published=published)

@@ -7,11 +7,13 @@ import numpy as np
 import pandas as pd
 
 from replication.qmc import discrepancy, point_set
+from replication.report.figures.base import figure
 
 PANELS = (("random", "random (uniform)"), ("halton", "Halton"), ("good_cos", "good point set, r = 2cos(2 pi i / p)"),
           ("good_exp", "good point set, r = exp(i)"))
 
 
+@figure("point_sets")
 def point_sets(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """``spec.n`` points in [0, 1)^2 of each set, with the centred L2 discrepancy in the title."""
     n = int(spec.get("n", 400))

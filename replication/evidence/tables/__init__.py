@@ -1,0 +1,8 @@
+"""Report tables, one module per kind; importing the package registers every kind."""
+
+from replication.evidence.tables import (  # noqa: F401  (each registers its kind)
+    attributes, comparison, discrepancy, improvement, modes, ranking, rating, summary,
+)
+from replication.evidence.tables.table import KEYS, Table, TableKind, match, pair
+
+__all__ = ["KEYS", "Table", "TableKind", "match", "pair"]

@@ -1,0 +1,25 @@
+"""Ours only: each metric's mean and 95% interval per method and condition."""
+
+import pandas as pd
+
+from replication.evidence.aggregate import summarise
+from replication.evidence.statistics import Estimate
+from replication.evidence.tables.table import Table, TableKind
+
+class Summary(TableKind):
+    """Ours only: one row per method and condition, one column per metric: its mean and 95% interval
+    (shown 'mean [low, high]'; in the CSV as the metric's column and its ``_low`` and ``_high``)."""
+
+    kind = "summary"
+    compares = False
+
+    def build(self, records: pd.DataFrame) -> Table:
+        columns = {metric: summarise(records, metric) for metric in self.spec["metrics"]}
+        first = columns[self.spec["metrics"][0]]
+        table = pd.DataFrame({"method": [self.label(m) for m in first["method"]],
+                              "condition": [c or "-" for c in first["condition"]], "runs": first["runs"]})
+        for metric, summary in columns.items():
+            table[metric] = [Estimate(*values, "") for values in
+                             zip(summary["mean"], summary["ci_low"], summary["ci_high"], summary["runs"])]
+        return Table(table)
+

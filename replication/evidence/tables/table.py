@@ -1,0 +1,187 @@
+"""A report table: rows of ours, the published cells they were matched with, and a verdict per cell.
+
+Every kind turns records into a :class:`Table`: one row per (method,
+condition) of ours, and for the kinds that compare with the paper, the
+published cells each row was matched with (by :func:`match`, the one rule
+for that) and a :class:`~replication.evidence.verdict.Verdict`.
+
+Add a kind by subclassing :class:`TableKind` in a module of this package with a
+new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+import pandas as pd
+
+from replication.evidence.published import cells
+from replication.evidence.statistics import Estimate
+from replication.evidence.verdict import Outcome, Verdict
+
+# the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
+# these, so the index shows how far the cells' verdicts move with it
+SENSITIVITY = (0.05, 0.20)
+KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
+
+
+@dataclass
+class Table:
+    """Rows of ours (``frame``: numbers, and a Verdict per row where compared), the published cells
+    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), and a
+    line a reader must see beside it (``note``: a ranking that is not reliable)."""
+
+    frame: pd.DataFrame
+    cells: list[dict] = field(default_factory=list)
+    note: str = ""
+
+    @property
+    def empty(self) -> bool:
+        return self.frame.empty
+
+    def shown(self) -> pd.DataFrame:
+        """The frame as text for a page: 'mean [low, high]', the paper's value, the verdict."""
+        shown = self.frame.drop(columns=["ours", "ci_low", "ci_high", "estimate", "verdict"], errors="ignore")
+        for column in _estimate_columns(shown):
+            shown[column] = [str(e) for e in shown[column]]
+        if "estimate" in self.frame:
+            shown.insert(3, "ours (95% CI)", [str(e) for e in self.frame["estimate"]])
+        if "paper" in shown:
+            shown["paper"] = [_printed(v) for v in shown["paper"]]
+        if "verdict" in self.frame:
+            shown["verdict"] = ["" if v is None else str(v) for v in self.frame["verdict"]]
+        return shown
+
+    @classmethod
+    def read(cls, frame: pd.DataFrame) -> "Table":
+        """A table back from the CSV :meth:`written` made (the PDF is drawn from those files)."""
+        frame = frame.copy()
+        if {"ours", "ci_low", "ci_high", "runs", "interval"} <= set(frame.columns):
+            frame["estimate"] = [Estimate(*row[:4], "" if pd.isna(row[4]) else row[4]) for row in
+                                 frame[["ours", "ci_low", "ci_high", "runs", "interval"]].itertuples(index=False)]
+        if {"outcome", "why"} <= set(frame.columns):
+            frame["verdict"] = [Verdict(Outcome(o), "" if pd.isna(w) else w) if isinstance(o, str) and o else None
+                                for o, w in zip(frame.pop("outcome"), frame.pop("why"))]
+        for column in [c for c in frame.columns if {f"{c}_low", f"{c}_high"} <= set(frame.columns)]:
+            frame[column] = [Estimate(v, lo, hi, n, "") for v, lo, hi, n in
+                             zip(frame[column], frame.pop(f"{column}_low"), frame.pop(f"{column}_high"), frame["runs"])]
+        return cls(frame)
+
+    def written(self) -> pd.DataFrame:
+        """The frame for a CSV: numbers as numbers (a metric's interval in its ``_low`` and ``_high``
+        columns), the verdict as its outcome and why."""
+        frame = self.frame.drop(columns=["estimate"], errors="ignore").copy()
+        for column in _estimate_columns(frame):
+            estimates = frame[column]
+            at = frame.columns.get_loc(column)
+            frame[column] = [e.value for e in estimates]
+            frame.insert(at + 1, f"{column}_low", [e.low for e in estimates])
+            frame.insert(at + 2, f"{column}_high", [e.high for e in estimates])
+        if "verdict" in frame:
+            frame["outcome"] = [v.outcome.value if v else "" for v in frame["verdict"]]
+            frame["why"] = [v.why if v else "" for v in frame["verdict"]]
+            frame = frame.drop(columns=["verdict"])
+        return frame
+
+
+def _estimate_columns(frame: pd.DataFrame) -> list[str]:
+    """The columns of a frame that hold an :class:`Estimate` per row (a summary table's metrics)."""
+    return [c for c in frame.columns if len(frame) and all(isinstance(v, Estimate) for v in frame[c])]
+
+
+def match(theirs: pd.DataFrame, method: str, condition: str, spec: dict) -> pd.DataFrame:
+    """The published cells our row (``method``, ``condition``) is compared with.
+
+    ``spec.match`` maps a condition of ours to the paper's: a condition
+    string, or ``{experiment: scene, condition: ...}``; an unmapped condition
+    is compared with the paper's of the same name.  A paper cell with no
+    condition takes ``spec.paper_condition`` (the paper's unstated N, say).
+    """
+    wanted = spec.get("match", {}).get(condition, {"condition": condition})
+    wanted = wanted if isinstance(wanted, dict) else {"condition": wanted}
+    chosen = theirs["method"] == method
+    if "condition" in wanted:
+        chosen &= theirs["condition"].replace("", spec.get("paper_condition", "")) == wanted["condition"]
+    if "experiment" in wanted:
+        chosen &= theirs["experiment"] == wanted["experiment"]
+    return theirs[chosen]
+
+
+class TableKind:
+    """One kind of report table; subclasses register themselves by ``kind``."""
+
+    kind: ClassVar[str]
+    compares: ClassVar[bool] = True  # whether its rows are matched with published cells
+    registry: ClassVar[dict[str, type["TableKind"]]] = {}
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        TableKind.registry[cls.kind] = cls
+
+    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame):
+        self.spec, self.experiment, self.published = spec, experiment, published
+
+    @classmethod
+    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame) -> "TableKind":
+        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison)."""
+        name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
+        if name not in cls.registry:
+            raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
+        return cls.registry[name](spec, experiment, published)
+
+    def build(self, records: pd.DataFrame) -> Table:
+        raise NotImplementedError
+
+    def label(self, method: str) -> str:
+        return self.experiment["methods"].get(method, {}).get("label", method)
+
+    def theirs(self) -> pd.DataFrame:
+        spec = self.spec
+        return cells(self.published, self.experiment["paper"], spec["paper_table"],
+                     spec.get("paper_metric", spec.get("metric")))
+
+    def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, ours=None) -> dict:
+        """A matched published cell for ``summary.json``: the cell's keys and our row's numbers."""
+        cell = self.published.loc[index]
+        return {
+            "published_index": int(index),
+            **{k: str(cell[k]) for k in KEYS},
+            "table_name": self.spec["name"],
+            "our_method": row["method"],
+            "our_condition": "" if row["condition"] == "-" else row["condition"],
+            "runs": int(row["runs"]),
+            "ours": ours if ours is not None else _number(estimate.value),
+            "value": _number(estimate.value) if estimate else None,  # a rating's too: the proportion behind it
+            "ci_low": _number(estimate.low) if estimate else None,
+            "ci_high": _number(estimate.high) if estimate else None,
+            "interval": estimate.method if estimate else "",
+            "verdict": verdict.as_dict() if verdict else None,
+        }
+
+
+def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
+    """``metric`` of two methods run on the same data (same data condition and repetition), side by side:
+    columns ``baseline``, ``method`` and ``repetition``, one row per shared repetition (at ``condition`` if
+    given)."""
+    columns = ["data_condition", "repetition", metric]
+    chosen = records if condition is None else records[records["condition"] == condition]
+    left = chosen[chosen["method"] == baseline][columns]
+    right = chosen[chosen["method"] == method][columns]
+    paired = left.merge(right, on=["data_condition", "repetition"], suffixes=("_baseline", "_method"))
+    return pd.DataFrame({"baseline": paired[f"{metric}_baseline"].astype(float),
+                         "method": paired[f"{metric}_method"].astype(float), "repetition": paired["repetition"]})
+
+
+def _printed(value) -> str:
+    if isinstance(value, str):
+        return value
+    return "" if value is None or not np.isfinite(value) else f"{value:g}"
+
+
+def _number(value) -> float | None:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) else None
