@@ -27,6 +27,7 @@ from omegaconf import DictConfig
 
 from replication import __version__
 from replication.errors import ConfigError, fail
+from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
 from replication.runner.lifeline import (
     child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
@@ -139,6 +140,7 @@ def run_experiment(cfg: DictConfig) -> None:
         return run_multiverse(cfg)
     try:
         runs, skipped, (backend, n_jobs, address) = prepare(cfg)
+        configure(cfg.inference)  # before any run: a mistyped setting fails now, not after hours of runs
     except ConfigError as error:
         fail(str(error))
     for message in skipped:
@@ -173,6 +175,7 @@ def run_multiverse(cfg: DictConfig) -> None:
     try:
         multiverse = load(cfg)
         backend, n_jobs, address = parallel_settings(cfg)
+        configure(cfg.inference)
     except ConfigError as error:
         fail(str(error))
     for message in multiverse.skipped:

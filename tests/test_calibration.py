@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from replication.evidence import calibration
-from replication.evidence.inference import ALPHA
+from replication.evidence.settings import INFERENCE
 from replication.paths import CONF_DIR, PACKAGE_DIR
 from replication.report.pages.calibration import CSV, NOTE, evidence_digest, failures, read, write_calibration
 from replication.evidence.claims import load_papers
@@ -31,7 +31,7 @@ def test_the_simulation_catches_the_old_rules(quick):
     # differences and the bootstrap's rank percentiles in this design hold theirs, and are shown as such)
     controls = quick[quick["control"] & (quick["truth"] == "null") & ~quick["test"].str.startswith("rank")]
     controls = controls[(controls["runs"] == 5) | (controls["checks"] == 9)]
-    assert len(controls) == 10 and (controls["rate"] > ALPHA + 2 * controls["mc_se"]).all()
+    assert len(controls) == 10 and (controls["rate"] > INFERENCE.alpha + 2 * controls["mc_se"]).all()
     any_fails = controls[controls["checks"] == 9]
     assert (any_fails["rate"] > 0.2).all()  # nine checks, any one failing: a claim wrong a quarter of the time
 

@@ -8,8 +8,9 @@ from scipy import stats
 
 from replication.evidence.comparisons import Effect, best_test, order_test
 from replication.evidence.inference import (
-    ALPHA, clopper_pearson, detectable, holm, mean_test, paired_binary_test, proportion_test, sign_test,
+    clopper_pearson, detectable, holm, mean_test, paired_binary_test, proportion_test, sign_test,
 )
+from replication.evidence.settings import INFERENCE
 from replication.evidence.verdict import OUTCOMES, Outcome, decide
 
 RNG = np.random.default_rng(7)
@@ -21,7 +22,7 @@ def test_mean_test_is_scipys_one_sample_t_test_with_its_90_percent_interval():
     scipy = stats.ttest_1samp(values, 0.5, alternative="greater")
     assert found.p_above == pytest.approx(scipy.pvalue)
     assert found.p_below == pytest.approx(stats.ttest_1samp(values, 0.5, alternative="less").pvalue)
-    interval = stats.ttest_1samp(values, 0.5).confidence_interval(1 - 2 * ALPHA)
+    interval = stats.ttest_1samp(values, 0.5).confidence_interval(1 - 2 * INFERENCE.alpha)
     assert (found.low, found.high) == pytest.approx((interval.low, interval.high))
 
 
@@ -76,7 +77,7 @@ def test_detectable_effect_has_80_percent_power():
     runs = 12
     effect = detectable(1.0, runs)
     found = mean_test(RNG.normal(effect, 1.0, (20_000, runs)))
-    assert np.mean(found.p_above < ALPHA) == pytest.approx(0.8, abs=0.02)
+    assert np.mean(found.p_above < INFERENCE.alpha) == pytest.approx(0.8, abs=0.02)
 
 
 def test_decide_by_hand():

@@ -2,6 +2,7 @@
 default universe equal to the experiments as they stand, and each claim's robustness across cases."""
 
 import numpy as np
+import pandas as pd
 import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
@@ -9,8 +10,11 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.claims import Claim, Reading, load_papers
-from replication.report.pages.multiverse import READING, Case, Robustness, write_multiverse_report
+from replication.evidence.claims import Check, Claim, Reading, Result, load_papers
+from replication.evidence.multiverse import READING, Case, Robustness
+from replication.evidence.schema import Summary
+from replication.evidence.statistics import Estimate
+from replication.report.pages.multiverse import write_multiverse_report
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
@@ -102,22 +106,20 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
     store = Store(tmp_path / "store", "hspf_ungm")
     assert execute(multiverse.runs_of("hspf_ungm"), store, n_jobs=1, backend="threading", progress=False) == 65
     page = write_multiverse_report(cfg, multiverse)
-    summary = OmegaConf.to_container(OmegaConf.load(page.parent / "summary.json"))
-    claim = summary["multiverse"]["hspf.ungm"]
+    claim = Summary.read(page.parent / "summary.json").multiverse["hspf.ungm"]
     readings = [r.name for p in load_papers() for c in p.claims if c.id == "hspf.ungm" for r in c.readings]
-    assert len(claim["cases"]) == 2 * len(readings)  # every universe with every reading of the claim
-    assert {tuple(p) for case in claim["cases"] for p in case["picks"]} >= {("hms", "paper"), ("hms", "larger")}
+    assert claim.cases == 2 * len(readings)  # every universe with every reading of the claim
+    cases = pd.read_csv(page.parent / "cases.csv")
+    assert {("hms", "paper"), ("hms", "larger")} <= set(zip(["hms"] * len(cases), cases["hms"]))
     assert (page.parent / "readings.png").exists() and (page.parent / "cases.csv").exists()
 
 
 def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", held: int = 1,
           per_run: dict | None = None) -> Case:
-    checks = tuple({"what": "A - B" if i == 0 else "other",
-                    "verdict": {"outcome": Outcome.REPRODUCED.value if i < held else outcome.value},
-                    "per_run": {str(k): v for k, v in (per_run or {}).items()} if i == 0 else {}}
-                   for i in range(2))
-    return Case(universe, (*picks.items(), (READING, reading)), Verdict(outcome),
-                {"what": "A - B", "number": universe, "value": 1.0}, checks)
+    checks = tuple(Check("A - B" if i == 0 else "other", Verdict(Outcome.REPRODUCED if i < held else outcome),
+                         per_run=dict(per_run or {}) if i == 0 else {}) for i in range(2))
+    deciding = Check("A - B", Verdict(outcome), Estimate(1.0, 0.5, 1.5, 10, "t"))
+    return Case(universe, (*picks.items(), (READING, reading)), Result(Verdict(outcome), checks, deciding))
 
 
 CLAIM = Claim("p.c", "p", "A beats B", "Table 1", {}, (Reading("r1", "e", {}),))
@@ -183,8 +185,9 @@ def test_the_scorecard_marks_a_claim_robust_or_reading_dependent_from_its_multiv
     papers = [p for p in load_papers() if p.key == "hspf"]
     cases = (_case("default", {"x": "a"}, Outcome.NOT_REPRODUCED, per_run=RUNS),
              _case("x=b", {"x": "b"}, Outcome.REPRODUCED, per_run=_shifted(1.0)))
-    stored = Robustness(papers[0].claims[0], cases).as_dict()
-    rows = claim_rows(papers, {"hspf_readings": {"multiverse": {papers[0].claims[0].id: stored}}})
+    stored = Robustness(papers[0].claims[0], cases).as_result()
+    rows = claim_rows(papers, {"hspf_readings": Summary("hspf_readings", "", "hspf", "quick", 0, 0,
+                                                        multiverse={papers[0].claims[0].id: stored})})
     first, second = rows["hspf"][:2]
     assert first.robust is False and first.robustness.startswith("depends on the reading")
     assert second.multiverse is None and second.robust is None

@@ -13,6 +13,7 @@ from replication.evidence.statistics import estimate, mean, median, paired_diffe
 from replication.errors import ConfigError
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict, judge_band, judge_value, stability_bands
 from replication.evidence.published import load_published
+from replication.evidence.schema import dump, load
 from replication.evidence.tables.comparison import Comparison
 
 EXPERIMENT = {
@@ -102,7 +103,7 @@ def test_cell_verdicts_need_equivalence_to_be_reproduced():
     rate = judge_value(39.3, runs, percent, paper_runs=100)  # 3 of 20 against 39 of 100: Fisher's exact test
     assert rate.p_against == pytest.approx(stats.fisher_exact([[3, 17], [39, 61]]).pvalue)
     assert str(Verdict(Outcome.NOT_REPRODUCED, "-50%")) == "not reproduced (-50%)"
-    assert Verdict.from_dict(Verdict(Outcome.INCONCLUSIVE, "x", 0.2, 0.3).as_dict()) == \
+    assert load(Verdict, dump(Verdict(Outcome.INCONCLUSIVE, "x", 0.2, 0.3))) == \
         Verdict(Outcome.INCONCLUSIVE, "x", 0.2, 0.3)
 
 
@@ -168,7 +169,7 @@ def test_table_joins_paper_values_and_judges_against_the_floor(published):
     assert rows.loc["-", "verdict"] is None  # the floor: a row of ours with no published counterpart
     # the paired excess over the floor is exact here: each run is floor + a constant
     assert rows.loc["N=10", "excess over the floor (paired, 95% CI)"] == "0.5 [0.5, 0.5]"
-    assert {e["published_index"] for e in table.cells} == {0, 1}  # the QPF cell stays unmatched
+    assert {e.published_index for e in table.cells} == {0, 1}  # the QPF cell stays unmatched
     shown = table.shown()
     assert {"ours (95% CI)", "paper", "verdict"} <= set(shown.columns) and "estimate" not in shown
     written = table.written()

@@ -18,7 +18,10 @@ from replication.report.pages.index import write_index
 from replication.evidence.published import load_published
 from replication.report.pages.render import ENVIRONMENT, browser, open_in_browser
 from replication.evidence.summary import counts, experiment_configs, summary_table
-from replication.evidence.tables import KEYS, TableKind
+from replication.evidence.schema import Summary, dump, load
+from replication.evidence.statistics import Estimate
+from replication.evidence.tables import KEYS, CellResult, TableKind
+from replication.evidence.verdict import Outcome, Verdict
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 CSV = (
@@ -47,12 +50,14 @@ CONFIGS = {
 }
 
 
-REPRODUCED = {"outcome": "reproduced", "why": ""}
+REPRODUCED = Verdict(Outcome.REPRODUCED)
 
 
-def _cell(published, index, **ours) -> dict:
-    return {"published_index": index, **{k: published.at[index, k] for k in KEYS}, "our_condition": "",
-            "runs": 20, "ci_low": None, "ci_high": None, **ours}
+def _cell(published, index, table_name, ours, verdict, ci_low=np.nan, ci_high=np.nan, our_condition=""
+          ) -> CellResult:
+    return CellResult(index, *(str(published.at[index, k]) for k in KEYS), table_name=table_name,
+                      our_method=published.at[index, "method"], our_condition=our_condition, runs=20,
+                      estimate=Estimate(ours, ci_low, ci_high, 20, "t"), verdict=verdict)
 
 
 @pytest.fixture
@@ -64,15 +69,15 @@ def published(tmp_path):
 
 def test_summary_has_one_row_per_published_cell_with_ours_or_a_reason(published):
     summaries = {
-        "qmc_ungm": {"scale": "paper", "n_records": 40, "cells": [
+        "qmc_ungm": Summary("qmc_ungm", "", "qmc", "paper", 40, 40, cells=(
             _cell(published, 0, table_name="t1", ours=4.0, ci_low=3.5, ci_high=4.5, verdict=REPRODUCED),
             _cell(published, 0, table_name="t1_other", ours=5.0,
-                  verdict={"outcome": "not reproduced", "why": "+19%"}),
-        ]},
-        "trk": {"scale": "quick", "n_records": 6, "cells": [
+                  verdict=Verdict(Outcome.NOT_REPRODUCED, "+19%")),
+        )),
+        "trk": Summary("trk", "", "trk", "quick", 6, 6, cells=(
             _cell(published, 4, table_name="time", our_condition="scene=office", ours=1.5,
-                  verdict={"outcome": "not testable", "why": "machine-dependent; ours/theirs = 0.33"}),
-        ]},
+                  verdict=Verdict(Outcome.NOT_TESTABLE, "machine-dependent; ours/theirs = 0.33")),
+        )),
     }
     table = summary_table(published, summaries, CONFIGS)
     assert len(table) == len(published)
@@ -100,12 +105,9 @@ def test_summary_has_one_row_per_published_cell_with_ours_or_a_reason(published)
 def test_index_shows_the_summary_from_the_experiments_summary_json(tmp_path, published):
     reports = tmp_path / "reports"
     (reports / "gps_qmcpf").mkdir(parents=True)
-    (reports / "gps_qmcpf" / "summary.json").write_text(json.dumps({
-        "name": "gps_qmcpf", "title": "QMC filters", "paper": "qmc", "scale": "quick", "n_records": 4,
-        "n_runs": 4, "verdicts": {"reproduced": 1},
-        "cells": [_cell(published, 0, table_name="table1_rmse", ours=4.0, ci_low=3.5, ci_high=4.5,
-                        verdict=REPRODUCED)],
-    }))
+    Summary("gps_qmcpf", "QMC filters", "qmc", "quick", 4, 4, cells=(
+        _cell(published, 0, table_name="table1_rmse", ours=4.0, ci_low=3.5, ci_high=4.5, verdict=REPRODUCED),
+    )).write(reports / "gps_qmcpf")
     page = write_index(reports, tmp_path / "published.csv")
     html = page.read_text()
     body = html.split('<table id="cells"', 1)[1].split("</table>", 1)[0]
@@ -148,12 +150,13 @@ def test_matched_cells_name_every_published_cell_a_table_matched(name):
     for spec in specs:
         table = TableKind.of(spec, experiment, published).build(records)
         entries = table.cells
-        assert all(e["our_method"] in set(table.frame["method"]) for e in entries), spec["name"]
-        pairs = {(e["published_index"], e["our_method"], e["our_condition"]) for e in entries}
+        assert all(e.our_method in set(table.frame["method"]) for e in entries), spec["name"]
+        pairs = {(e.published_index, e.our_method, e.our_condition) for e in entries}
         assert len(pairs) == len(entries)  # one entry per cell and row of ours (two stand-ins: two entries)
         for e in entries:
-            assert tuple(e[k] for k in KEYS) == tuple(published.loc[e["published_index"], KEYS])
-        json.dumps(entries, allow_nan=False)  # plain JSON: no NaN, no numpy types
+            assert e.key == tuple(published.loc[e.published_index, list(KEYS)])
+        written = json.loads(json.dumps(dump(entries), allow_nan=False))  # plain JSON: no NaN, no numpy types
+        assert dump(load(tuple[CellResult, ...], written)) == written  # and back through the one schema
         compared += len(entries)
     if name == "gps_qmcpf":
         assert compared == 28  # Table 1 (12 RMSE, 12 times) and Table 2 (4 ESS at N = 100)
@@ -223,7 +226,9 @@ def test_every_page_is_self_contained(reports):
             assert (page.parent / src).read_bytes().startswith(b"\x89PNG\r\n\x1a\n"), f"{page}: {src}"
     import replication.report
 
-    for template in (Path(replication.report.__file__).parent / "templates").glob("*.j2"):
+    templates = sorted((Path(replication.report.__file__).parent / "pages" / "templates").glob("*.j2"))
+    assert len(templates) >= 5
+    for template in templates:
         assert not re.search(r"(src|href)\s*=\s*['\"]?(https?:)?//", template.read_text()), template
 
 
@@ -232,13 +237,9 @@ def test_summary_in_the_index_covers_every_published_cell(reports):
     summary = pd.read_csv(reports / "summary.csv", dtype=str, keep_default_na=False)
     assert list(summary["method"]) == list(published["method"]) and len(summary) == len(published)
     assert (summary["verdict"] != "").ne(summary["reason"] != "").all()
-    stored = json.loads((reports / "gps_qmcpf" / "summary.json").read_text())
     rmse = summary[(summary["paper"] == "gps_qmcpf") & (summary["table"] == "1")
                    & (summary["metric"] == "rmse")]
-    if "cells" in stored:  # experiment.py lists the cells its tables matched
-        assert (rmse["verdict"] != "").all() and rmse["link"].str.startswith("gps_qmcpf/index.html#").all()
-    else:
-        assert rmse["reason"].str.startswith("see gps_qmcpf's page").all()
+    assert (rmse["verdict"] != "").all() and rmse["link"].str.startswith("gps_qmcpf/index.html#").all()
     html = (reports / "index.html").read_text()
     assert 'href="replication.pdf"' in html and 'id="cells"' in html
     assert html.index('id="scorecard"') < html.index('id="cells"')  # the claims come first
@@ -311,7 +312,7 @@ def test_pdf_has_the_summary_then_every_table_and_figure(reports):
         pytest.skip("no PDF text extractor: pypdf is not installed and pdftotext is not on the PATH")
     flat = " ".join(text.split())
     for name, summary in summaries.items():
-        assert summary["title"] in flat, name
+        assert summary.title in flat, name
     assert "Every published cell" in flat and "Table 1: RMSE of the state estimate" in flat
     assert flat.index("Scorecard") < flat.index("Every published cell")
     assert "Quick scale" in flat

@@ -6,7 +6,7 @@ of the sequence's mean over runs: every sequence weighs the same, whatever its
 length or run count (the toolkit averages the sequences' curves).  Precision at
 20 px and the success AUC are linear in those curves, so this is the value the
 toolkit's plots give.  The sequences are the ones at hand, not a sample: an
-interval (where each sequence has at least :data:`MIN_RUNS` runs) is over runs
+interval (where each sequence has at least :data:`INFERENCE.min_runs` runs) is over runs
 only, and an attribute carried by one sequence is that sequence's score.
 The attributes of a sequence come from OTB-100's list
 (:func:`replication.scenes.otb.otb_attributes`); a scene without one (a
@@ -18,8 +18,9 @@ import pandas as pd
 from replication.condition import label_of, values_of
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import stratified_mean
-from replication.evidence.verdict import MIN_RUNS
+
 from replication.scenes.otb import otb_attributes
+from replication.evidence.settings import INFERENCE
 
 METRICS = ("precision20", "success_auc")  # OTB's two scores
 
@@ -56,7 +57,7 @@ def attribute_scores(records: pd.DataFrame, experiment: dict, metrics=METRICS) -
             for metric in metrics:
                 kind = quantity(metric)
                 row[metric] = stratified_mean([values.astype(float) for _, values in by_sequence[metric]],
-                                              kind.low, kind.high, MIN_RUNS)
+                                              kind.low, kind.high, INFERENCE.min_runs)
             rows.append(row)
     return pd.DataFrame(rows, columns=["attribute", "meaning", "sequences", "method", "series", "runs",
                                        *metrics])

@@ -43,11 +43,12 @@ import pandas as pd
 from scipy import stats
 
 from replication.evidence.comparisons import Effect, best_test, order_test
-from replication.evidence.inference import ALPHA, holm, mean_test, sign_test
+from replication.evidence.inference import holm, mean_test, sign_test
 from replication.evidence.ranking import rank, rank_set
 from replication.evidence.robustness import depends
 from replication.evidence.quantities import Quantity
 from replication.evidence.verdict import OUTCOMES, Outcome, cell_test, decide, judge_band, judge_value, stability_bands
+from replication.evidence.settings import INFERENCE
 
 REPLICATIONS = 10_000  # make calibrate: a Monte Carlo standard error of at most 0.005 on every row
 QUICK_REPLICATIONS = 800  # the test suite's version
@@ -361,7 +362,7 @@ def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
             "truth": case.truth, "guards": case.guards, "effect": case.effect, "rate": rate, "mc_se": mc_se,
             "wrong_rate": rate if null else float(np.mean(codes == (NOT_REPRODUCED if guarded == REPRODUCED
                                                                      else REPRODUCED))),
-            "power": math.nan if null else rate, "holds": (rate <= ALPHA + 2 * mc_se) if null else None,
+            "power": math.nan if null else rate, "holds": (rate <= INFERENCE.alpha + 2 * mc_se) if null else None,
             "control": case.control, "replications": replications}
 
 

@@ -28,7 +28,7 @@ import pandas as pd
 import yaml
 
 from replication.evidence.comparisons import Effect, OrderTest, best_test, order_test
-from replication.evidence.inference import ALPHA, Test, mean_test, proportion_test, said_p, sign_test
+from replication.evidence.inference import Test, mean_test, proportion_test, said_p, sign_test
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
@@ -37,6 +37,7 @@ from replication.qmc import discrepancy_table
 from replication.evidence.published import cells as published_cells
 from replication.evidence.ranking import rankings, unreliable
 from replication.evidence.tables import Table, match, pair
+from replication.evidence.settings import INFERENCE
 
 CLAIMS_DIR = CONF_DIR / "claims"
 
@@ -133,17 +134,6 @@ class Result:
         why = f"{held} of {len(testable)} checks hold; {deciding.what}" + (f": {said}" if said else "")
         against = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_against[i]  # what decided it
         return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(against)), tuple(checks), deciding)
-
-    def as_dict(self) -> dict:
-        def check(c: Check) -> dict:
-            e = c.estimate
-            return {"what": c.what, "verdict": c.verdict.as_dict(), "number": c.number,
-                    "value": _number(e.value) if e else None, "low": _number(e.low) if e else None,
-                    "high": _number(e.high) if e else None, "runs": e.runs if e else None,
-                    "reference": c.reference, "per_run": {str(k): _number(v) for k, v in c.per_run.items()}}
-
-        return {"verdict": self.verdict.as_dict(), "checks": [check(c) for c in self.checks],
-                "deciding": check(self.deciding) if self.deciding else None}
 
 
 def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) -> Check:
@@ -269,15 +259,15 @@ def _order_verdict(tested: OrderTest, paper: Effect | None, unit: float, binary:
     if p_for is None and p_against is None:
         return Verdict(Outcome.NOT_TESTABLE, "every run gives the same difference: no test")
     sized = tested.size is not None
-    if p_against is not None and p_against < ALPHA:
-        if sized and p_for is not None and p_for < ALPHA:
+    if p_against is not None and p_against < INFERENCE.alpha:
+        if sized and p_for is not None and p_for < INFERENCE.alpha:
             why = f"the sign agrees, the size does not: the paper's {paper} is absent, {said_p(p_against)}"
         elif sized:
             why = f"the paper's {paper} is absent here, {said_p(p_against)}"
         else:
             why = f"the other way round, {said_p(p_against)}"
         return Verdict(Outcome.NOT_REPRODUCED, why, p_for, p_against)
-    if p_for is not None and p_for < ALPHA:
+    if p_for is not None and p_for < INFERENCE.alpha:
         size = f"; consistent with the paper's {paper}" if sized else ""
         return Verdict(Outcome.REPRODUCED, f"{said_p(p_for)}{size}", p_for, p_against)
     smallest = tested.detectable * unit
@@ -300,17 +290,12 @@ class Cells(ClaimTest):
         found = []
         for name in self.tables:
             table = tables.get(name)
-            for entry in [] if table is None else table.cells:
-                estimate = None
-                if entry.get("value") is not None:
-                    estimate = Estimate(entry["value"], entry["ci_low"] if entry["ci_low"] is not None else math.nan,
-                                        entry["ci_high"] if entry["ci_high"] is not None else math.nan,
-                                        entry["runs"], entry.get("interval", ""))
-                what = f"{entry['method']} {entry['experiment']} {entry['condition']}".strip()
-                verdict = Verdict.from_dict(entry["verdict"]) if entry["verdict"] else Verdict(Outcome.NOT_TESTABLE)
-                if isinstance(entry["ours"], str):  # a rating: the proportion of runs behind it is the number
-                    what = f"{what} (ours: {entry['ours']})"
-                found.append(Check(what, verdict, estimate, reference=_number(_float(entry.get("paper")))))
+            for cell in [] if table is None else table.cells:
+                what = f"{cell.method} {cell.experiment} {cell.condition}".strip()
+                if cell.rating:  # a rating: the proportion of runs behind it is the number
+                    what = f"{what} (ours: {cell.rating})"
+                found.append(Check(what, cell.verdict or Verdict(Outcome.NOT_TESTABLE), cell.estimate,
+                                   reference=cell.paper_number))
         return found
 
 
@@ -351,9 +336,9 @@ def _threshold_verdict(p_for: float | None, p_against: float | None, against: st
     """A one-sided test each way: its verdict before the reading's Holm (``then``: said after the why)."""
     if p_for is None and p_against is None:
         return Verdict(Outcome.NOT_TESTABLE, f"every run ties: no test{then}")
-    if p_for is not None and p_for < ALPHA:
+    if p_for is not None and p_for < INFERENCE.alpha:
         return Verdict(Outcome.REPRODUCED, f"{said_p(p_for)}{then}", p_for, p_against)
-    if p_against is not None and p_against < ALPHA:
+    if p_against is not None and p_against < INFERENCE.alpha:
         return Verdict(Outcome.NOT_REPRODUCED, f"{against}, {said_p(p_against)}{then}", p_for, p_against)
     return Verdict(Outcome.INCONCLUSIVE, f"{said_p(p_for)} for, {said_p(p_against)} against{then}", p_for,
                    p_against)
@@ -440,7 +425,7 @@ def load_papers(directory: Path = CLAIMS_DIR) -> tuple[Paper, ...]:
 
 
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table],
-             published: pd.DataFrame | None = None) -> dict:
+             published: pd.DataFrame | None = None) -> dict[str, dict[str, "Result"]]:
     """The results of every reading that names experiment ``name``: {claim id: {reading name: result}}
     (``published``: the paper's numbers, whose sizes the ``order`` tests compare with ours)."""
     results = {}
@@ -451,24 +436,12 @@ def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[st
                     continue
                 test = ClaimTest.of(reading.test, experiment, published)
                 checks = test.checks(records, tables) if len(records) or not test.needs_runs else []
-                results.setdefault(claim.id, {})[reading.name] = Result.of(checks).as_dict()
+                results.setdefault(claim.id, {})[reading.name] = Result.of(checks)
     return results
 
 
 def _listed(value) -> list:
     return [] if value is None else list(value) if isinstance(value, (list, tuple)) else [value]
-
-
-def _float(value) -> float:
-    """A published value as a number (NaN for a rating or an empty cell)."""
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def _number(value) -> float | None:
-    return float(value) if value is not None and math.isfinite(value) else None
 
 
 def _finite(value) -> float | None:

@@ -1,9 +1,9 @@
 """The hypothesis tests behind every verdict, exact or at nominal level for the run counts used (scipy.stats).
 
-Every decision is a one-sided test at :data:`ALPHA` (5 %) in one direction:
+Every decision is a one-sided test at :data:`INFERENCE.alpha` (5 %) in one direction:
 ``p_above`` is the p-value of "the true value is above the reference"
 (H0: at or below it), ``p_below`` of "below" (H0: at or above).  The interval
-of a :class:`Test` is the two-sided (1 - 2 ALPHA) = 90 % interval whose each
+of a :class:`Test` is the two-sided (1 - 2 INFERENCE.alpha) = 90 % interval whose each
 bound is the one-sided 95 % bound, so a test rejects exactly when the
 reference lies beyond the bound on its side.
 
@@ -27,8 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-ALPHA = 0.05  # the one-sided level of every decision
-POWER = 0.80  # the power at which the smallest detectable effect is quoted
+from replication.evidence.settings import INFERENCE
 
 
 @dataclass(frozen=True)
@@ -60,7 +59,7 @@ def mean_test(values, reference=0.0) -> Test:
     spread = se > 1e-12 * np.maximum(1.0, np.abs(mean))
     with np.errstate(all="ignore"):
         t = np.where(spread, (mean - reference) / se, np.nan)
-        half = stats.t.ppf(1 - ALPHA, n - 1) * se if n > 1 else np.nan
+        half = stats.t.ppf(1 - INFERENCE.alpha, n - 1) * se if n > 1 else np.nan
     p_above = stats.t.sf(t, n - 1) if n > 1 else np.full(np.shape(t), np.nan)
     low, high = np.where(spread, mean - half, np.nan), np.where(spread, mean + half, np.nan)
     return Test(mean, low, high, p_above, np.where(np.isfinite(t), 1.0 - p_above, np.nan), n, "t")
@@ -76,7 +75,7 @@ def sign_test(values, reference=0.0) -> Test:
     p_above = np.where(untied > 0, stats.binom.sf(above - 1, untied, 0.5), np.nan)
     p_below = np.where(untied > 0, stats.binom.sf(below - 1, untied, 0.5), np.nan)
     ordered = np.sort(x, axis=-1)
-    rank = int((stats.binom.cdf(np.arange(n + 1), n, 0.5) <= ALPHA).sum())  # [x_(rank), x_(n + 1 - rank)]
+    rank = int((stats.binom.cdf(np.arange(n + 1), n, 0.5) <= INFERENCE.alpha).sum())  # [x_(rank), x_(n + 1 - rank)]
     if rank >= 1:
         low, high = ordered[..., rank - 1], ordered[..., n - rank]
     else:
@@ -87,13 +86,13 @@ def sign_test(values, reference=0.0) -> Test:
 def paired_binary_test(differences) -> Test:
     """Paired yes/no outcomes (``differences`` in {-1, 0, 1}: ours minus theirs per run): McNemar's exact
     test, the sign test on the discordant pairs, and a conservative interval for the difference of the
-    two rates, p10 - p01, from the Clopper-Pearson bounds of each (each at ALPHA / 2)."""
+    two rates, p10 - p01, from the Clopper-Pearson bounds of each (each at INFERENCE.alpha / 2)."""
     d = np.asarray(differences, dtype=float)
     n = d.shape[-1]
     found = sign_test(d)
     wins, losses = (d > 0).sum(axis=-1), (d < 0).sum(axis=-1)
-    win_low, win_high = clopper_pearson(wins, n, 1 - ALPHA)
-    loss_low, loss_high = clopper_pearson(losses, n, 1 - ALPHA)
+    win_low, win_high = clopper_pearson(wins, n, 1 - INFERENCE.alpha)
+    loss_low, loss_high = clopper_pearson(losses, n, 1 - INFERENCE.alpha)
     return Test(d.mean(axis=-1), win_low - loss_high, win_high - loss_low, found.p_above, found.p_below, n,
                 "exact McNemar (sign) test")
 
@@ -101,7 +100,7 @@ def paired_binary_test(differences) -> Test:
 def proportion_test(successes, runs: int, reference: float) -> Test:
     """The exact binomial test of a rate against ``reference``, with the Clopper-Pearson interval."""
     k = np.asarray(successes)
-    low, high = clopper_pearson(k, runs, 1 - 2 * ALPHA)
+    low, high = clopper_pearson(k, runs, 1 - 2 * INFERENCE.alpha)
     return Test(k / runs, low, high, stats.binom.sf(k - 1, runs, reference), stats.binom.cdf(k, runs, reference),
                 runs, "exact binomial test")
 
@@ -132,11 +131,11 @@ def holm(p_values) -> np.ndarray:
 
 
 def detectable(sd: float, runs: int) -> float:
-    """The smallest true mean (in the units of ``sd``, the per-run spread) that a one-sided t-test at ALPHA
-    over ``runs`` runs detects with probability :data:`POWER` (the normal-theory approximation)."""
+    """The smallest true mean (in the units of ``sd``, the per-run spread) that a one-sided t-test at INFERENCE.alpha
+    over ``runs`` runs detects with probability :data:`INFERENCE.power` (the normal-theory approximation)."""
     if runs < 2 or not np.isfinite(sd):
         return float("nan")
-    return float((stats.t.ppf(1 - ALPHA, runs - 1) + stats.t.ppf(POWER, runs - 1)) * sd / np.sqrt(runs))
+    return float((stats.t.ppf(1 - INFERENCE.alpha, runs - 1) + stats.t.ppf(INFERENCE.power, runs - 1)) * sd / np.sqrt(runs))
 
 
 def said_p(p: float) -> str:

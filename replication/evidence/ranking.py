@@ -35,14 +35,12 @@ import pandas as pd
 
 from replication.evidence.quantities import quantity
 from replication.evidence.comparisons import best_test
-from replication.evidence.inference import ALPHA, holm
-from replication.evidence.statistics import LEVEL, Estimate, paired_difference
-from replication.evidence.verdict import MIN_RUNS
-from replication.condition import label_of, values_of
+from replication.evidence.inference import holm
+from replication.evidence.statistics import Estimate, paired_difference
 
-MIN_SEQUENCES = 5  # no ranking verdict over fewer sequences: one sequence more or less can reorder them
-RESAMPLES = 2999
-SEED = 20261123  # the bootstrap's own stream: a report is a pure function of the records
+from replication.condition import label_of, values_of
+from replication.evidence.settings import INFERENCE
+
 TIE = 1e-12  # means closer than this (relative to the largest score) are level: summation order, not skill
 
 
@@ -91,7 +89,7 @@ class Ranking:
         """Method ``i``'s mean over the sequences (of its mean over runs) and the percentile interval of
         its resampled means."""
         value = float(self.scores[:, :, i].mean())
-        low, high = np.quantile(self.means[:, i], [(1 - LEVEL) / 2, (1 + LEVEL) / 2])
+        low, high = np.quantile(self.means[:, i], [(1 - INFERENCE.level) / 2, (1 + INFERENCE.level) / 2])
         return Estimate(value, float(low), float(high), self.runs, "two-level bootstrap, percentile")
 
     @property
@@ -135,7 +133,7 @@ def shown_orders(per_sequence, i: int, lower_is_better: bool) -> tuple[np.ndarra
     tested = best_test(per_sequence, i, lower_is_better)
     m = np.shape(per_sequence)[-1]
     adjusted = holm(np.concatenate([tested.p_for, tested.p_against], axis=-1))
-    shown = np.nan_to_num(adjusted, nan=1.0) < ALPHA
+    shown = np.nan_to_num(adjusted, nan=1.0) < INFERENCE.alpha
     return shown[..., : m - 1], shown[..., m - 1:]
 
 
@@ -162,9 +160,9 @@ def rank(scores: np.ndarray, methods, sequences, lower_is_better: bool) -> Ranki
     method on a sequence sharing its data and seed (the runs are resampled together)."""
     scores = np.asarray(scores, dtype=float)
     n_sequences, n_runs, n_methods = scores.shape
-    rng = np.random.default_rng(SEED)
-    drawn = rng.integers(0, n_sequences, size=(RESAMPLES, n_sequences, 1))
-    runs = rng.integers(0, n_runs, size=(RESAMPLES, n_sequences, n_runs))
+    rng = np.random.default_rng(INFERENCE.bootstrap_seed)
+    drawn = rng.integers(0, n_sequences, size=(INFERENCE.bootstrap_resamples, n_sequences, 1))
+    runs = rng.integers(0, n_runs, size=(INFERENCE.bootstrap_resamples, n_sequences, n_runs))
     means = scores[drawn, runs].mean(axis=(1, 2))  # resamples x methods
     sign = -1.0 if lower_is_better else 1.0
     lead = sign * (means[:, :, None] - means[:, None, :])  # [b, i, j]: how far i is ahead of j
@@ -217,15 +215,15 @@ def rankings(records: pd.DataFrame, spec: dict) -> dict[str, Ranking]:
 
 
 def unreliable(ranking: Ranking, experiment: dict) -> str:
-    """Why a ranking is not reliable ('' when it is): fewer than :data:`MIN_RUNS` runs per sequence,
-    fewer than :data:`MIN_SEQUENCES` sequences, or sequences cut short (a scene's ``first`` or ``last``
+    """Why a ranking is not reliable ('' when it is): fewer than :data:`INFERENCE.min_runs` runs per sequence,
+    fewer than :data:`INFERENCE.min_sequences` sequences, or sequences cut short (a scene's ``first`` or ``last``
     frame set, as at the quick scale: a ranking of the first 100 frames is not one of the sequences)."""
     found = []
-    if ranking.runs < MIN_RUNS:
+    if ranking.runs < INFERENCE.min_runs:
         runs = f"{ranking.runs} run{'s' if ranking.runs > 1 else ''}"
-        found.append(f"{runs} per sequence (fewer than {MIN_RUNS})")
-    if len(ranking.sequences) < MIN_SEQUENCES:
-        found.append(f"{len(ranking.sequences)} sequences (fewer than {MIN_SEQUENCES})")
+        found.append(f"{runs} per sequence (fewer than {INFERENCE.min_runs})")
+    if len(ranking.sequences) < INFERENCE.min_sequences:
+        found.append(f"{len(ranking.sequences)} sequences (fewer than {INFERENCE.min_sequences})")
     scenes = experiment.get("scenes", {})
     cut = {s: (scenes[s].get("first") or 0, scenes[s].get("last")) for s in ranking.sequences
            if s in scenes and (scenes[s].get("first") or scenes[s].get("last"))}

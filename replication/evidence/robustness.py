@@ -22,9 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.evidence.inference import ALPHA, holm, mean_test
+from replication.evidence.inference import holm, mean_test
 from replication.evidence.statistics import Estimate, paired_difference
 from replication.evidence.verdict import Outcome
+from replication.evidence.settings import INFERENCE
 
 DECISIVE = {Outcome.REPRODUCED, Outcome.NOT_REPRODUCED}  # two decisive verdicts conflict; one inconclusive does not
 
@@ -44,7 +45,7 @@ class ChoiceEffect:
 
     @property
     def significant(self) -> bool:
-        return math.isfinite(self.adjusted) and self.adjusted < ALPHA
+        return math.isfinite(self.adjusted) and self.adjusted < INFERENCE.alpha
 
     @property
     def moves(self) -> bool:
@@ -70,7 +71,7 @@ def paired_effect(alternative: dict, twin: dict) -> tuple[Estimate | None, float
 def depends(adjusted, flipped) -> np.ndarray:
     """The rule: an alternative moves the verdict where its verdict differs from its twin's and its effect on
     the deciding statistic survives Holm (``adjusted``) at 5 %."""
-    return np.asarray(flipped) & (np.nan_to_num(np.asarray(adjusted, dtype=float), nan=1.0) < ALPHA)
+    return np.asarray(flipped) & (np.nan_to_num(np.asarray(adjusted, dtype=float), nan=1.0) < INFERENCE.alpha)
 
 
 def adjust(effects: list[tuple[str, str, Estimate | None, float, int, int, str]]) -> list[ChoiceEffect]:

@@ -15,15 +15,16 @@ import pandas as pd
 
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
-from replication.evidence.claims import Claim, Paper, Reading
+from replication.evidence.claims import Check, Claim, Paper, Reading
+from replication.evidence.schema import RobustnessResult, Summary
 
 
 @dataclass(frozen=True)
 class ReadingResult:
     reading: Reading
     verdict: Verdict
-    deciding: dict | None  # the deciding check as stored: what, number, value, low, high, runs
-    checks: tuple[dict, ...]
+    deciding: Check | None
+    checks: tuple[Check, ...]
     scale: str
 
 
@@ -31,7 +32,7 @@ class ReadingResult:
 class ClaimRow:
     claim: Claim
     results: tuple[ReadingResult, ...]
-    multiverse: dict | None = None  # its robustness across the paper's multiverse, as stored (if it was run)
+    multiverse: RobustnessResult | None = None  # its robustness across the paper's multiverse (if it was run)
     multiverse_experiment: str = ""
 
     @property
@@ -50,7 +51,7 @@ class ClaimRow:
     @property
     def robust(self) -> bool | None:
         """The same verdict in every case of the paper's multiverse (None: not run, or too few cases)."""
-        return None if self.multiverse is None else self.multiverse["robust"]
+        return None if self.multiverse is None else self.multiverse.robust
 
     @property
     def robustness(self) -> str:
@@ -59,7 +60,7 @@ class ClaimRow:
         readings of the stored results (where it hinges only on readings that give conflicting decisive
         verdicts)."""
         if self.multiverse is not None:
-            return self.multiverse["summary"]
+            return self.multiverse.summary
         judged = [r for r in self.results if r.verdict.outcome is not Outcome.NOT_TESTABLE]
         if len(self.results) == 1:
             return "one reading"
@@ -74,27 +75,26 @@ class ClaimRow:
         return f"no reading contradicts another (an inconclusive reading is no contradiction): {listed}"
 
 
-def claim_rows(papers: list[Paper], summaries: dict[str, dict]) -> dict[str, list[ClaimRow]]:
+def claim_rows(papers: list[Paper], summaries: dict[str, Summary]) -> dict[str, list[ClaimRow]]:
     """Per paper, its claims with every reading's stored result (not testable where none is stored), and
     its robustness across the paper's multiverse where one was run."""
     across = {claim: (name, stored) for name, summary in summaries.items()
-              for claim, stored in summary.get("multiverse", {}).items()}
+              for claim, stored in summary.multiverse.items()}
     return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings),
                                  *reversed(across.get(claim.id, ("", None))))
                         for claim in paper.claims] for paper in papers}
 
 
-def _result(claim: Claim, reading: Reading, summaries: dict[str, dict]) -> ReadingResult:
+def _result(claim: Claim, reading: Reading, summaries: dict[str, Summary]) -> ReadingResult:
     summary = summaries.get(reading.experiment)
     if summary is None:
         return ReadingResult(reading, Verdict(Outcome.NOT_TESTABLE, f"not run yet: experiment={reading.experiment}"),
                              None, (), "")
-    stored = summary.get("claims", {}).get(claim.id, {}).get(reading.name)
+    stored = summary.claims.get(claim.id, {}).get(reading.name)
     if stored is None:
         why = f"no result stored: python -m replication.report experiment={reading.experiment}"
-        return ReadingResult(reading, Verdict(Outcome.NOT_TESTABLE, why), None, (), summary.get("scale", ""))
-    return ReadingResult(reading, Verdict.from_dict(stored["verdict"]), stored.get("deciding"),
-                         tuple(stored.get("checks", ())), summary.get("scale", ""))
+        return ReadingResult(reading, Verdict(Outcome.NOT_TESTABLE, why), None, (), summary.scale)
+    return ReadingResult(reading, stored.verdict, stored.deciding, stored.checks, summary.scale)
 
 
 def tally(rows: list[ClaimRow]) -> dict[str, int]:
@@ -133,12 +133,14 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
     table = []
     for paper, claims in rows.items():
         for row in claims:
-            deciding = row.primary.deciding or {}
+            deciding = row.primary.deciding
+            estimate = deciding.estimate if deciding and deciding.estimate else None
             table.append({
                 "paper": paper, "claim_id": row.claim.id, "claim": row.claim.text, "source": row.claim.source,
                 "verdict": row.verdict.outcome.value, "reason": row.verdict.why,
-                "number": deciding.get("value"), "ci_low": deciding.get("low"), "ci_high": deciding.get("high"),
-                "runs": deciding.get("runs"), "deciding": deciding.get("what", ""),
+                "number": estimate.value if estimate else None, "ci_low": estimate.low if estimate else None,
+                "ci_high": estimate.high if estimate else None, "runs": estimate.runs if estimate else None,
+                "deciding": deciding.what if deciding else "",
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
                 "robust": row.robust, **_across(row),
                 "scale": row.primary.scale,
@@ -151,13 +153,10 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
 def _across(row: ClaimRow) -> dict:
     """The multiverse's columns of ``claims.csv``: cases, the alternatives that flip the verdict, the
     best case for the paper and its number (empty where the paper's multiverse was not run)."""
-    stored = row.multiverse or {}
-    best = stored.get("best_case") or {}
-    return {
-        "cases": len(stored.get("cases", [])) or None,
-        "flipped_by": "; ".join(stored.get("flipped_by", [])),
-        "best_case": best.get("label", ""),
-        "best_case_verdict": (best.get("verdict") or {}).get("outcome", ""),
-        "best_case_number": (best.get("deciding") or {}).get("number", ""),
-        "multiverse": row.multiverse_experiment,
-    }
+    stored = row.multiverse
+    if stored is None:
+        return {"cases": None, "flipped_by": "", "best_case": "", "best_case_verdict": "", "best_case_number": "",
+                "multiverse": ""}
+    return {"cases": stored.cases, "flipped_by": "; ".join(stored.flipped_by), "best_case": stored.best_case,
+            "best_case_verdict": stored.best_case_verdict.outcome.value, "best_case_number": stored.best_case_number,
+            "multiverse": row.multiverse_experiment}

@@ -22,8 +22,7 @@ import numpy as np
 from scipy import stats
 
 from replication.evidence.quantities import Quantity
-
-LEVEL = 0.95
+from replication.evidence.settings import INFERENCE
 
 
 @dataclass(frozen=True)
@@ -69,7 +68,7 @@ def proportion(successes: int, runs: int) -> Estimate:
     """The share of runs with an outcome and its exact Clopper-Pearson interval."""
     if runs == 0:
         return Estimate(math.nan, math.nan, math.nan, 0, "Clopper-Pearson")
-    interval = stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=LEVEL, method="exact")
+    interval = stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=INFERENCE.level, method="exact")
     return Estimate(successes / runs, float(interval.low), float(interval.high), int(runs), "Clopper-Pearson")
 
 
@@ -82,7 +81,7 @@ def mean(values, low: float = -math.inf, high: float = math.inf) -> Estimate:
     centre = float(values.mean())
     if len(values) < 2 or np.all(values == values[0]):
         return Estimate(centre, math.nan, math.nan, len(values), "t (every run equal)" if len(values) > 1 else "t")
-    half = float(stats.t.ppf((1 + LEVEL) / 2, len(values) - 1) * values.std(ddof=1) / np.sqrt(len(values)))
+    half = float(stats.t.ppf((1 + INFERENCE.level) / 2, len(values) - 1) * values.std(ddof=1) / np.sqrt(len(values)))
     return Estimate(centre, max(centre - half, low), min(centre + half, high), len(values), "t")
 
 
@@ -106,7 +105,7 @@ def stratified_mean(groups, low: float = -math.inf, high: float = math.inf, min_
     if parts.sum() == 0:
         return Estimate(centre, math.nan, math.nan, runs, "stratified t (every run equal)")
     df = parts.sum() ** 2 / np.sum(parts ** 2 / np.array([len(values) - 1 for values in groups]))
-    half = float(stats.t.ppf((1 + LEVEL) / 2, df) * np.sqrt(parts.sum()))
+    half = float(stats.t.ppf((1 + INFERENCE.level) / 2, df) * np.sqrt(parts.sum()))
     return Estimate(centre, max(centre - half, low), min(centre + half, high), runs, "stratified t")
 
 
@@ -116,8 +115,8 @@ def median(values) -> Estimate:
     n = len(values)
     if n == 0:
         return Estimate(math.nan, math.nan, math.nan, 0, "order statistics")
-    low_rank = int(stats.binom.ppf((1 - LEVEL) / 2, n, 0.5))
-    high_rank = int(stats.binom.isf((1 - LEVEL) / 2, n, 0.5))
+    low_rank = int(stats.binom.ppf((1 - INFERENCE.level) / 2, n, 0.5))
+    high_rank = int(stats.binom.isf((1 - INFERENCE.level) / 2, n, 0.5))
     middle = float(np.median(values))
     if low_rank < 1 or high_rank >= n:  # too few runs for a 95% order-statistic interval
         return Estimate(middle, math.nan, math.nan, n, "order statistics")

@@ -10,30 +10,34 @@ not reproduce (a private video, say), no value in the paper, or not yet
 replicated at all.
 """
 
-import json
 from collections import Counter
 from dataclasses import dataclass
 import sys
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import yaml
 
-from replication.evidence.verdict import Verdict
+from replication.evidence.schema import Summary
+from replication.evidence.tables import KEYS, CellResult
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.tables import KEYS
 
 # -- the summary of every published cell --------------------------------------------------------------
 
 
-def load_summaries(reports: Path) -> dict[str, dict]:
-    """Each experiment's ``summary.json`` under ``reports``, by experiment name (configs' order)."""
+def load_summaries(reports: Path) -> dict[str, Summary]:
+    """Each experiment's ``summary.json`` under ``reports``, by experiment name (configs' order).  One that
+    an older version wrote in another schema is left out with one line on stderr (redraw it)."""
     summaries = {}
     for name in experiment_names():
         path = Path(reports) / name / "summary.json"
-        if path.exists():
-            summaries[name] = json.loads(path.read_text())
+        if not path.exists():
+            continue
+        try:
+            summaries[name] = Summary.read(path)
+        except (KeyError, TypeError, ValueError) as error:
+            print(f"skipped: {path} is in an older schema ({error!r}); redraw it: python -m replication.report "
+                  f"experiment={name}", file=sys.stderr)
     return summaries
 
 
@@ -63,7 +67,7 @@ def experiment_configs() -> dict[str, dict]:
 
 
 def summary_table(
-    published: pd.DataFrame, summaries: dict[str, dict], configs: dict[str, dict], claims: list[str] | None = None
+    published: pd.DataFrame, summaries: dict[str, Summary], configs: dict[str, dict], claims: list[str] | None = None
 ) -> pd.DataFrame:
     """One row per published cell (the csv's order): the paper's value, ours and the verdict, or why not.
 
@@ -76,8 +80,8 @@ def summary_table(
     """
     by_key = {}
     for name, summary in summaries.items():
-        for entry in summary.get("cells", []):
-            by_key.setdefault(tuple(str(entry.get(k, "")) for k in KEYS), []).append((name, summary, entry))
+        for entry in summary.cells:
+            by_key.setdefault(entry.key, []).append((name, entry))
     scene_notes = _scene_notes(published)
     rows = []
     for index, cell in published.iterrows():
@@ -88,20 +92,18 @@ def summary_table(
                    reason="", reason_kind="", also="", our_condition="", runs="", link="", link_text="",
                    claim=claims[index] if claims else "")
         if found:
-            name, summary, entry = found[0]
-            row["ours"] = _ours(entry)
+            name, entry = found[0]
+            row["ours"] = entry.ours
             row["outcome"], row["verdict"] = _verdict(entry)
-            row["tag"] = (entry.get("verdict") or {}).get("tag", "")
-            ours_named = entry.get("our_condition") or ""
-            if ours_named != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
-                row["our_condition"] = ours_named
-            row["runs"] = "" if entry.get("runs") is None else str(entry["runs"])
-            row["link"] = f"{name}/index.html#{entry['table_name']}"
-            row["link_text"] = f"{name}: {entry['table_name']}"
+            row["tag"] = entry.verdict.tag if entry.verdict else ""
+            if entry.our_condition != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
+                row["our_condition"] = entry.our_condition
+            row["runs"] = str(entry.runs)
+            row["link"] = f"{name}/index.html#{entry.table_name}"
+            row["link_text"] = f"{name}: {entry.table_name}"
             row["also"] = "; ".join(
-                f"{e.get('table_name')}{' ' + e['our_condition'] if e.get('our_condition') else ''}: "
-                f"{_ours(e)}, {_verdict(e)[1]}"
-                for _, _, e in found[1:]
+                f"{e.table_name}{' ' + e.our_condition if e.our_condition else ''}: {e.ours}, {_verdict(e)[1]}"
+                for _, e in found[1:]
             )
         else:
             unmatched, name = _why_not(cell, summaries, configs, scene_notes)
@@ -115,7 +117,7 @@ def summary_table(
     return pd.DataFrame(rows, columns=columns)
 
 
-def counts(table: pd.DataFrame, summaries: dict[str, dict] | None = None) -> dict:
+def counts(table: pd.DataFrame, summaries: dict[str, Summary] | None = None) -> dict:
     """How many cells were compared, with which outcomes, and why the others were not (first words); with
     ``summaries``, also the outcomes of the numbers judged within a tolerance, as configured and at each
     other tolerance (``sensitivity``: {'as configured' or '+-5%': {outcome: count}})."""
@@ -124,25 +126,22 @@ def counts(table: pd.DataFrame, summaries: dict[str, dict] | None = None) -> dic
     reasons = table[table["reason_kind"] != ""]["reason_kind"].value_counts()
     moved, seen = {}, set()
     for summary in (summaries or {}).values():  # the first entry of each cell, as summary_table shows it
-        for entry in summary.get("cells", []):
-            if entry["published_index"] in seen:
+        for entry in summary.cells:
+            if entry.published_index in seen:
                 continue
-            seen.add(entry["published_index"])
-            if entry.get("at_tolerance"):
-                moved.setdefault("as configured", Counter())[entry["verdict"]["outcome"]] += 1
-            for tolerance, outcome in entry.get("at_tolerance", {}).items():
-                moved.setdefault(f"+-{float(tolerance):.0%}", Counter())[outcome] += 1
+            seen.add(entry.published_index)
+            if entry.at_tolerance:
+                moved.setdefault("as configured", Counter())[entry.verdict.outcome.value] += 1
+            for tolerance, outcome in entry.at_tolerance.items():
+                moved.setdefault(f"+-{float(tolerance):.0%}", Counter())[outcome.value] += 1
     return {"cells": len(table), "compared": len(compared), "verdicts": dict(verdicts.items()),
             "reasons": dict(reasons.items()),
             "sensitivity": {t: dict(c) for t, c in moved.items()}}
 
 
-def _verdict(entry: dict) -> tuple[str, str]:
-    """(outcome, the verdict as read) of a stored entry; a row of ours without a published number has none."""
-    if not entry.get("verdict"):
-        return "", "no published number"
-    verdict = Verdict.from_dict(entry["verdict"])
-    return verdict.outcome.value, str(verdict)
+def _verdict(entry: CellResult) -> tuple[str, str]:
+    """(outcome, the verdict as read) of a matched cell; a row of ours without a published number has none."""
+    return (entry.verdict.outcome.value, str(entry.verdict)) if entry.verdict else ("", "no published number")
 
 
 def _paper_value(cell: pd.Series) -> str:
@@ -150,18 +149,6 @@ def _paper_value(cell: pd.Series) -> str:
     if not value:
         return ""
     return f"{value} {cell['unit']}".strip() if cell["unit"] else value
-
-
-def _ours(entry: dict) -> str:
-    ours = entry.get("ours")
-    if ours is None:
-        return ""
-    if isinstance(ours, str):
-        return ours
-    low, high = entry.get("ci_low"), entry.get("ci_high")
-    if low is None or high is None or not (np.isfinite(low) and np.isfinite(high)):
-        return f"{ours:.4g}"
-    return f"{ours:.4g} [{low:.4g}, {high:.4g}]"
 
 
 def _scene_notes(published: pd.DataFrame) -> dict[tuple, str]:
@@ -228,11 +215,8 @@ def _why_not(cell: pd.Series, summaries: dict, configs: dict, scene_notes: dict)
     if name not in summaries:
         return Unmatched("not run yet", f"experiment={name}"), name
     summary = summaries[name]
-    if "cells" not in summary:  # written before reports listed the cells they matched
-        return Unmatched("written before reports listed their cells",
-                         f"see {name}'s page, or python -m replication.report"), name
-    if not summary.get("n_records"):
+    if not summary.n_records:
         return Unmatched("not run yet", f"no stored runs of {name}"), name
-    if summary.get("scale") != "paper":
-        return Unmatched("not run at this scale", f"{name} at scale=paper (ran at {summary.get('scale')})"), name
+    if summary.scale != "paper":
+        return Unmatched("not run at this scale", f"{name} at scale=paper (ran at {summary.scale})"), name
     return Unmatched("not matched", f"no row of {name} met this cell (see its page)"), name

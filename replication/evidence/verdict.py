@@ -16,46 +16,11 @@ from enum import Enum
 import numpy as np
 from scipy import stats
 
-from replication.evidence.inference import ALPHA, clopper_pearson, holm, mean_test, said_p, sign_test
+from replication.evidence.inference import clopper_pearson, holm, mean_test, said_p, sign_test
 from replication.evidence.quantities import Quantity
+from replication.evidence.settings import INFERENCE
 
-MIN_RUNS = 5  # no verdict from fewer runs
-TOLERANCE = 0.10  # a published number is reproduced within +-10 % of it where its table states no other
-# The t-based equivalence test's level per side, a size correction set by simulation (reports/calibration.csv),
-# not on any reported data: at 5 % a mean of skewed per-run values (skewness 1.75) is called equivalent to a
-# number at the band's edge up to 10.6 % of the time; at 1.5 % at most 5 %, for a power loss only at 10-50 runs.
-# No test of a mean holds its level under every skew (Bahadur & Savage 1956).
-EQUIVALENCE_ALPHA = 0.015
 BAYES_FLOOR = "bayes_floor"  # the tag of a published RMSE below what any filter achieves on average
-
-RULES = (  # the rules in words, one short paragraph per kind of test; every page prints them
-    "Every decision is a one-sided test at 5 %, and every interval that decides is exact or holds its level at the "
-    "run counts used: reports/calibration.csv simulates each rule through the code that applies it. With 5 paired "
-    "runs the smallest one-sided p-value of an exact test is 1/32.",
-    "Two methods (a claim's check): Student's paired t-test on common random numbers, McNemar's exact (sign) test "
-    "for yes/no outcomes. Where the claim or its published cells quote a size, the paper's own gap (a difference, "
-    "or a ratio in Fieller's linear form) is tested against ours, so that 'the effect the paper reports is absent "
-    "here' and 'the sign agrees, the size does not' are verdicts.",
-    "A claim: reproduced when every check shows the claimed direction (an intersection-union test, no correction "
-    "needed); not reproduced when some check's evidence against it (the other direction, or the paper's size "
-    "absent) survives Holm's correction across the reading's checks; else inconclusive, with the smallest effect "
-    "the runs detect at 80 % power.",
-    "A bound (frames per second, say): the exact sign test of the median, the exact binomial test of a rate, the "
-    "t-test of a mean. 'X is best': X against each competitor, the paired t-test over the sequences, reproduced "
-    "when it beats all and not reproduced when one is better after Holm; P(best) describes and decides nothing.",
-    "A published number counts as ours within +-10 % of it unless its table states another tolerance: reproduced "
-    "only where equivalence is shown (two one-sided t-tests, each at 1.5 % so that skewed runs hold 5 %; our "
-    "interval widened for the paper's own Monte Carlo noise where its run count is known), not reproduced where "
-    "our 95 % interval lies wholly outside the band (a rate with its run count known: Fisher's exact test) or the "
-    "number is below the Bayes floor (the point-mass filter's RMSE, which no filter beats on average); else "
-    "inconclusive: a wide interval that merely contains the paper's number shows nothing. A rating is reproduced "
-    "when the 95 % Clopper-Pearson interval meets only the paper's band.",
-    "A reading: a verdict depends on the paper's open choices only where a choice's paired effect on the deciding "
-    "statistic is significant (two-sided, Holm across the choices) and its verdict changes with it.",
-    "Not testable: a timing (machine-dependent: the ratio ours / theirs is shown), fewer than 5 runs, every run "
-    "tied (no interval), or no data.",
-)
-
 
 class Outcome(Enum):
     REPRODUCED = "reproduced"
@@ -82,15 +47,6 @@ class Verdict:
     def __str__(self) -> str:
         return f"{self.outcome.value} ({self.why})" if self.why else self.outcome.value
 
-    def as_dict(self) -> dict:
-        return {"outcome": self.outcome.value, "why": self.why, "p_for": _number(self.p_for),
-                "p_against": _number(self.p_against), "tag": self.tag}
-
-    @classmethod
-    def from_dict(cls, data: dict) -> "Verdict":
-        return cls(Outcome(data["outcome"]), data.get("why", ""), data.get("p_for"), data.get("p_against"),
-                   data.get("tag", ""))
-
 
 def decide(p_for, p_against) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The rule: per check (last axis) and for the reading as a whole, from each check's one-sided p-values
@@ -98,15 +54,15 @@ def decide(p_for, p_against) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     Returns (check codes, reading codes, Holm-adjusted p_against), codes indexing :data:`OUTCOMES`.  A check
     is not reproduced where its p_against survives Holm across the reading's testable checks, reproduced
-    where its p_for < ALPHA (and nothing against it survives), else inconclusive.  The reading: not
+    where its p_for < INFERENCE.alpha (and nothing against it survives), else inconclusive.  The reading: not
     reproduced where any check is; reproduced where every testable check is (intersection-union); not
     testable where no check is; else inconclusive.
     """
     p_for, p_against = np.asarray(p_for, dtype=float), np.asarray(p_against, dtype=float)
     testable = np.isfinite(p_for) | np.isfinite(p_against)
     adjusted = holm(np.where(testable, np.nan_to_num(p_against, nan=1.0), np.nan))
-    against = testable & (adjusted < ALPHA)
-    held = testable & ~against & (np.nan_to_num(p_for, nan=1.0) < ALPHA)
+    against = testable & (adjusted < INFERENCE.alpha)
+    held = testable & ~against & (np.nan_to_num(p_for, nan=1.0) < INFERENCE.alpha)
     codes = np.select([~testable, against, held], [3, 1, 0], 2)
     any_testable = testable.any(axis=-1)
     reading = np.select([~any_testable, against.any(axis=-1), (held | ~testable).all(axis=-1)], [3, 1, 0], 2)
@@ -114,17 +70,18 @@ def decide(p_for, p_against) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def too_few(runs: int) -> Verdict | None:
-    """The verdict for fewer than :data:`MIN_RUNS` runs, else None."""
-    return Verdict(Outcome.NOT_TESTABLE, f"too few runs ({runs})") if runs < MIN_RUNS else None
+    """The verdict for fewer than :data:`INFERENCE.min_runs` runs, else None."""
+    return Verdict(Outcome.NOT_TESTABLE, f"too few runs ({runs})") if runs < INFERENCE.min_runs else None
 
 
 def judge_value(paper: float, values, quantity: Quantity, statistic: str = "mean", paper_runs: int | None = None,
-                floor: np.ndarray | None = None, tolerance: float = TOLERANCE) -> Verdict | None:
+                floor: np.ndarray | None = None, tolerance: float | None = None) -> Verdict | None:
     """A published number against our per-run ``values`` of the same quantity; None when the paper has no
     number.  ``floor``: the Bayes floor's per-run values on the same data (an RMSE below it is not
-    reproduced); ``tolerance``: the relative margin of equivalence."""
+    reproduced); ``tolerance``: the relative margin of equivalence (None: the inference setting's)."""
     if paper is None or not math.isfinite(paper):
         return None
+    tolerance = INFERENCE.tolerance if tolerance is None else tolerance
     values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
     if quantity.machine_dependent:
@@ -134,9 +91,9 @@ def judge_value(paper: float, values, quantity: Quantity, statistic: str = "mean
     few = too_few(len(values))
     if few:
         return few
-    if floor is not None and len(floor) >= MIN_RUNS:
+    if floor is not None and len(floor) >= INFERENCE.min_runs:
         below = mean_test(floor, paper).p_above  # H1: the floor lies above the paper's value
-        if np.isfinite(below) and below < ALPHA:
+        if np.isfinite(below) and below < INFERENCE.alpha:
             return Verdict(Outcome.NOT_REPRODUCED, f"below the Bayes floor {np.mean(floor):.3g} ({said_p(below)})",
                            None, float(below), BAYES_FLOOR)
     if quantity.proportion:
@@ -147,7 +104,7 @@ def judge_value(paper: float, values, quantity: Quantity, statistic: str = "mean
     return _cell(paper, float(np.mean(values)), float(p_for), float(p_against), tolerance)
 
 
-def cell_test(paper: float, values, tolerance: float = TOLERANCE, paper_runs: int | None = None,
+def cell_test(paper: float, values, tolerance: float | None = None, paper_runs: int | None = None,
               statistic: str = "mean") -> tuple[np.ndarray, np.ndarray]:
     """(p_for, p_against) of a published number against per-run ``values`` (last axis: runs), the band of
     ``tolerance`` x |paper| around it counting as the same number: p_for, that ours lies inside the band
@@ -156,7 +113,7 @@ def cell_test(paper: float, values, tolerance: float = TOLERANCE, paper_runs: in
     ours).  The t-test's standard error is widened by sqrt(1 + runs / ``paper_runs``) for the published
     mean's own noise."""
     values = np.asarray(values, dtype=float)
-    margin = tolerance * abs(paper)
+    margin = (INFERENCE.tolerance if tolerance is None else tolerance) * abs(paper)
     test = sign_test if statistic == "median" else mean_test
     if statistic != "median" and paper_runs:  # spread about the mean: the t-test's standard error grows alike
         centre = values.mean(axis=-1, keepdims=True)
@@ -164,7 +121,7 @@ def cell_test(paper: float, values, tolerance: float = TOLERANCE, paper_runs: in
     low, high = test(values, paper - margin), test(values, paper + margin)
     p_for = np.maximum(low.p_above, high.p_below)
     if test is mean_test:
-        p_for = np.minimum(1.0, p_for * (ALPHA / EQUIVALENCE_ALPHA))
+        p_for = np.minimum(1.0, p_for * (INFERENCE.alpha / INFERENCE.equivalence_alpha))
     return p_for, np.minimum(1.0, 2 * np.minimum(low.p_below, high.p_above))
 
 
@@ -179,7 +136,7 @@ def _judge_rate(paper: float, values: np.ndarray, quantity: Quantity, paper_runs
         p_against = float(stats.fisher_exact([[successes, runs - successes], [k, paper_runs - k]]).pvalue)
     else:
         p_against = float(stats.binomtest(successes, runs, min(max(rate, 0.0), 1.0)).pvalue)
-    low, high = clopper_pearson(successes, runs, 1 - 2 * ALPHA)
+    low, high = clopper_pearson(successes, runs, 1 - 2 * INFERENCE.alpha)
     p_for = 0.0 if rate - theirs <= low and high <= rate + theirs else 1.0  # equivalence: inside the margin
     return _cell(paper, successes / runs * quantity.high, p_for, p_against, margin / abs(paper) if paper else 0.0)
 
@@ -203,7 +160,7 @@ def judge_band(paper: str, successes: int, runs: int, bands: dict[str, tuple[flo
     few = too_few(runs)
     if few:
         return few
-    low, high = (float(v) for v in clopper_pearson(successes, runs, 1 - ALPHA))
+    low, high = (float(v) for v in clopper_pearson(successes, runs, 1 - INFERENCE.alpha))
     rate = successes / runs
     met = [name for name, (lo, hi) in bands.items() if low <= hi and high >= lo]
     ours = next((name for name, (lo, hi) in bands.items() if lo <= rate <= hi), "?")
@@ -230,8 +187,4 @@ def _band_p(successes: int, runs: int, band: tuple[float, float]) -> float:
     if successes > high * runs:
         return float(min(1.0, 2 * stats.binom.sf(successes - 1, runs, high)))
     return 1.0
-
-
-def _number(value) -> float | None:
-    return float(value) if value is not None and math.isfinite(value) else None
 

@@ -16,6 +16,7 @@ import sys
 from hydra import compose, initialize_config_dir
 
 from replication.errors import ConfigError, fail
+from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.report.pages.experiment import write_experiment_report
 from replication.report.pages.index import write_index
@@ -64,6 +65,7 @@ def main(argv: list[str]) -> None:
                 continue
             cfg = compose("config", overrides=[f"experiment={name}", *overrides])
             try:
+                configure(cfg.inference)
                 if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
                     page = write_multiverse_report(cfg, load_multiverse(cfg))
                 else:

@@ -35,9 +35,10 @@ from replication.evidence.published import load_published  # noqa: E402
 from replication.evidence.claims import load_papers  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.evidence.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
+from replication.evidence.schema import Summary  # noqa: E402
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.evidence.tables import Table  # noqa: E402
-from replication.evidence.verdict import RULES  # noqa: E402
+from replication.evidence.settings import rules  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
 FONT = 7.0  # table text, points: the smallest that reads in print (a long cell wraps rather than shrinks)
@@ -63,7 +64,7 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     cells = summary_table(published, summaries, configs, owner_of_cells(papers, published))
     path = reports / "replication.pdf"
     reports.mkdir(parents=True, exist_ok=True)
-    quick = [name for name, s in summaries.items() if s.get("scale") != "paper"]
+    quick = [name for name, s in summaries.items() if s.scale != "paper"]
     banner = (f"Quick scale ({len(quick)} of {len(summaries)} experiments): fewer runs and shorter scenes than "
               f"the papers'. Paper scale: {PAPER_COMMAND}." if quick else None)
     tallies = cell_tallies(cells)
@@ -74,17 +75,17 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
             _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key], tallies),
                          widths=SCORECARD_COLUMNS,
                          subtitle=f"{paper.authors}; {paper.venue} ({paper.key}). Claims: {counted}.")
-        _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": list(RULES)}), widths={"rules": 200})
+        _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": list(rules())}), widths={"rules": 200})
         _table_pages(pdf, "Every published cell", _summary_frame(cells), widths=SUMMARY_COLUMNS,
                      subtitle="One row per published value: ours and the verdict where a table of ours "
                      "matched it, otherwise why not")
         for name, summary in summaries.items():
-            heading = summary.get("title", name)
-            for table in _tables(reports / name, summary, configs.get(name, {})):
+            heading = summary.title
+            for table in [t for t in summary.tables if (reports / name / t["csv"]).exists()]:
                 frame = _shown(pd.read_csv(reports / name / table["csv"]))
                 subtitle = " ".join(filter(None, [table["title"], table.get("note")]))
                 _table_pages(pdf, heading, frame, subtitle=subtitle, font=TABLE_FONT)
-            for figure in _figures(reports / name, summary, configs.get(name, {})):
+            for figure in [f for f in summary.figures if (reports / name / f["file"]).exists()]:
                 _figure_page(pdf, heading, figure["title"], reports / name / figure["file"])
         info = pdf.infodict()
         info["Title"] = TITLE
@@ -92,23 +93,6 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
         info["Creator"] = f"replication {replication.__version__}"
     _outline(path, pdf.marks)
     return path
-
-
-def _tables(folder: Path, summary: dict, config: dict) -> list[dict]:
-    """An experiment's tables: as its ``summary.json`` lists them, else its config's whose CSV exists."""
-    if "tables" in summary:
-        return [t for t in summary["tables"] if (folder / t["csv"]).exists()]
-    specs = config.get("report", {}).get("tables", [])
-    return [{"title": s["title"], "csv": f"{s['name']}.csv"}
-            for s in specs if (folder / f"{s['name']}.csv").exists()]
-
-
-def _figures(folder: Path, summary: dict, config: dict) -> list[dict]:
-    if "figures" in summary:
-        return [f for f in summary["figures"] if (folder / f["file"]).exists()]
-    specs = config.get("report", {}).get("figures", [])
-    return [{"title": s["title"], "file": f"{s['name']}.png"}
-            for s in specs if (folder / f"{s['name']}.png").exists()]
 
 
 def _shown(frame: pd.DataFrame) -> pd.DataFrame:
@@ -148,21 +132,21 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     return pd.DataFrame({
         "claim": [f"{r.claim.text} ({r.claim.source})" for r in rows],
         "verdict": [r.verdict.outcome.value for r in rows],
-        "deciding number (90% CI)": [(r.primary.deciding or {}).get("number", "") for r in rows],
+        "deciding number (90% CI)": [r.primary.deciding.number if r.primary.deciding else "" for r in rows],
         "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
         "readings": [r.primary.reading.name + ("" if len(r.results) == 1 and r.multiverse is None
                                                else f"; {r.robustness}") for r in rows],
     })
 
 
-def _title_page(pdf: PdfPages, summaries: dict, cells: pd.DataFrame, rows: dict) -> None:
+def _title_page(pdf: PdfPages, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict) -> None:
     fig = plt.figure(figsize=PAGE)
     fig.text(0.05, 0.92, TITLE, fontsize=18, weight="bold", va="top")
     cell_tally = counts(cells)
     verdicts = ", ".join(f"{k}: {v}" for k, v in cell_tally["verdicts"].items())
     claims = [row for paper_rows in rows.values() for row in paper_rows]
     claim_tally = ", ".join(f"{n} {outcome}" for outcome, n in tally(claims).items())
-    quick = [s for s in summaries.values() if s.get("scale") != "paper"]
+    quick = [s for s in summaries.values() if s.scale != "paper"]
     lines = [
         f"Generated {datetime.date.today().isoformat()} by replication {replication.__version__}.",
         f"{len(claims)} claims of five papers tested ({claim_tally}): the scorecard follows, one page per paper.",
@@ -173,8 +157,8 @@ def _title_page(pdf: PdfPages, summaries: dict, cells: pd.DataFrame, rows: dict)
              linespacing=1.5, parse_math=False)
     missing = [name for name in experiment_names() if name not in summaries]
     rows = [
-        [s.get("title", name), s.get("scale", ""), f"{s.get('n_records', '')} / {s.get('n_runs', '')}",
-         ", ".join(f"{k}: {v}" for k, v in sorted(s.get("verdicts", {}).items())) or "-"]
+        [s.title, s.scale, f"{s.n_records} / {s.n_runs}", ", ".join(f"{k}: {v}" for k, v in sorted(s.verdicts.items()))
+         or "-"]
         for name, s in summaries.items()
     ]
     frame = pd.DataFrame(rows, columns=["experiment", "scale", "runs stored", "verdicts"])

@@ -1,6 +1,7 @@
 """Ours beside the paper's number, judged: the kind of Tables 1-4 of most papers."""
 
 import math
+from dataclasses import replace
 
 import pandas as pd
 
@@ -8,7 +9,8 @@ from replication.evidence.aggregate import summarise
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate, paired_difference
 from replication.evidence.tables.table import SENSITIVITY, Table, TableKind, match
-from replication.evidence.verdict import TOLERANCE, Verdict, judge_value
+from replication.evidence.verdict import Verdict, judge_value
+from replication.evidence.settings import INFERENCE
 
 FLOOR_FILTER = "point_mass"  # the Bayes floor: the point-mass filter
 
@@ -44,7 +46,7 @@ class Comparison(TableKind):
                 return judge_value(paper, row["values"], kind, spec.get("statistic", "mean"), spec.get("paper_runs"),
                                    floor_runs, tolerance)
 
-            verdict = judged(spec.get("tolerance", TOLERANCE))
+            verdict = judged(spec.get("tolerance", INFERENCE.tolerance))
             shown = {"method": self.label(row["method"]), "condition": row["condition"] or "-",
                      "runs": row["runs"], "estimate": estimate, "ours": row["mean"], "ci_low": row["ci_low"],
                      "ci_high": row["ci_high"], "interval": row["interval"]}
@@ -55,8 +57,8 @@ class Comparison(TableKind):
                 shown["variance over runs"] = row["variance"]
             shown.update(paper=paper, verdict=verdict)
             rows.append(shown)
-            moved = {f"{t:g}": judged(t).outcome.value for t in SENSITIVITY} if verdict else {}
-            entries += [{**self.entry(i, shown, verdict, estimate), "at_tolerance": moved} for i in hit.index]
+            moved = {f"{t:g}": judged(t).outcome for t in SENSITIVITY} if verdict else {}
+            entries += [replace(self.entry(i, shown, verdict, estimate), at_tolerance=moved) for i in hit.index]
         return Table(pd.DataFrame(rows), entries)
 
 

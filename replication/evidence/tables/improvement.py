@@ -7,7 +7,8 @@ import pandas as pd
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import paired_difference
 from replication.evidence.tables.table import Table, TableKind, pair
-from replication.evidence.verdict import TOLERANCE, judge_value
+from replication.evidence.verdict import judge_value
+from replication.evidence.settings import INFERENCE
 
 class Improvement(TableKind):
     """A paper's relative claim, 100 (metric[baseline] - metric[method]) / mean metric[baseline] in %,
@@ -30,7 +31,7 @@ class Improvement(TableKind):
         # relative margin of a 1.8 % improvement would be a hair's breadth
         margin = spec["tolerance_pp"]
         verdict = judge_value(paper, improvements, quantity("improvement"),
-                              tolerance=margin / abs(paper) if paper else TOLERANCE)
+                              tolerance=margin / abs(paper) if paper else INFERENCE.tolerance)
         row = {"method": f"{self.label(method)} vs {self.label(baseline)}", "condition": "-",
                "runs": estimate.runs, "estimate": estimate, "ours": estimate.value, "ci_low": estimate.low,
                "ci_high": estimate.high, "interval": estimate.method, "paper": paper, "verdict": verdict}

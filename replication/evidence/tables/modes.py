@@ -75,6 +75,6 @@ class Modes(TableKind):
                    "runs keeping both modes (Clopper-Pearson 95% CI)": str(estimate), "ours": ours, "paper": paper,
                    "verdict": verdict}
             rows.append(row)
-            entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
+            entries += [self.entry(i, row, verdict, estimate, rating=ours) for i in hit.index]
         return Table(pd.DataFrame(rows), entries)
 

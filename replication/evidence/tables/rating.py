@@ -25,6 +25,6 @@ class Rating(TableKind):
                    "failed runs": failures, "failure rate (Clopper-Pearson 95% CI)": str(estimate), "rating": ours,
                    "paper": paper, "verdict": verdict}
             rows.append(row)
-            entries += [self.entry(i, row, verdict, estimate, ours=ours) for i in hit.index]
+            entries += [self.entry(i, row, verdict, estimate, rating=ours) for i in hit.index]
         return Table(pd.DataFrame(rows), entries)
 

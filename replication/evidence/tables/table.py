@@ -9,7 +9,6 @@ Add a kind by subclassing :class:`TableKind` in a module of this package with a
 new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
 """
 
-import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -23,7 +22,39 @@ from replication.evidence.verdict import Outcome, Verdict
 # the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
 # these, so the index shows how far the cells' verdicts move with it
 SENSITIVITY = (0.05, 0.20)
-KEYS = ["paper", "table", "experiment", "method", "metric", "condition"]
+KEYS = ("paper", "table", "experiment", "method", "metric", "condition")  # a published cell's identity
+
+
+@dataclass(frozen=True)
+class CellResult:
+    """A published cell one of our tables matched: the cell's keys, our row, its estimate and verdict, and
+    the verdict at each other equivalence tolerance (``at_tolerance``: '0.05' -> outcome)."""
+
+    published_index: int
+    paper: str
+    table: str
+    experiment: str
+    method: str
+    metric: str
+    condition: str
+    table_name: str
+    our_method: str
+    our_condition: str
+    runs: int
+    paper_number: float | None = None  # the published value as a number (None: a rating, a word)
+    estimate: Estimate | None = None  # a rating's too: the proportion behind it
+    rating: str = ""  # ours as a word (a rating, 'success'), where the paper's cell is one
+    verdict: Verdict | None = None
+    at_tolerance: dict[str, Outcome] = field(default_factory=dict)
+
+    @property
+    def key(self) -> tuple[str, ...]:
+        return tuple(getattr(self, k) for k in KEYS)
+
+    @property
+    def ours(self) -> str:
+        """Ours as a reader sees it: the word, or 'mean [low, high]'."""
+        return self.rating or ("" if self.estimate is None else str(self.estimate))
 
 
 @dataclass
@@ -33,7 +64,7 @@ class Table:
     line a reader must see beside it (``note``: a ranking that is not reliable)."""
 
     frame: pd.DataFrame
-    cells: list[dict] = field(default_factory=list)
+    cells: list[CellResult] = field(default_factory=list)
     note: str = ""
 
     @property
@@ -141,23 +172,14 @@ class TableKind:
         return cells(self.published, self.experiment["paper"], spec["paper_table"],
                      spec.get("paper_metric", spec.get("metric")))
 
-    def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, ours=None) -> dict:
+    def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, rating: str = ""
+              ) -> CellResult:
         """A matched published cell for ``summary.json``: the cell's keys and our row's numbers."""
         cell = self.published.loc[index]
-        return {
-            "published_index": int(index),
-            **{k: str(cell[k]) for k in KEYS},
-            "table_name": self.spec["name"],
-            "our_method": row["method"],
-            "our_condition": "" if row["condition"] == "-" else row["condition"],
-            "runs": int(row["runs"]),
-            "ours": ours if ours is not None else _number(estimate.value),
-            "value": _number(estimate.value) if estimate else None,  # a rating's too: the proportion behind it
-            "ci_low": _number(estimate.low) if estimate else None,
-            "ci_high": _number(estimate.high) if estimate else None,
-            "interval": estimate.method if estimate else "",
-            "verdict": verdict.as_dict() if verdict else None,
-        }
+        return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec["name"],
+                          our_method=row["method"], our_condition="" if row["condition"] == "-" else row["condition"],
+                          runs=int(row["runs"]),
+                          paper_number=None if pd.isna(cell["number"]) else float(cell["number"]), estimate=estimate, rating=rating, verdict=verdict)
 
 
 def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
@@ -178,10 +200,3 @@ def _printed(value) -> str:
         return value
     return "" if value is None or not np.isfinite(value) else f"{value:g}"
 
-
-def _number(value) -> float | None:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None

@@ -26,11 +26,12 @@ from omegaconf import OmegaConf  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
 from replication.evidence import calibration  # noqa: E402
-from replication.evidence.inference import ALPHA, detectable  # noqa: E402
-from replication.evidence.verdict import EQUIVALENCE_ALPHA  # noqa: E402
+from replication.evidence.inference import detectable  # noqa: E402
+  # noqa: E402
 from replication.paths import CONF_DIR, resolve  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.runner.provenance import run_code_digest  # noqa: E402
+from replication.evidence.settings import INFERENCE  # noqa: E402
 
 CSV = "calibration.csv"
 NOTE = "calibration.json"
@@ -43,9 +44,11 @@ def evidence_digest() -> str:
 
 
 def load_or_calibrate(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> pd.DataFrame:
-    """The stored table when the deciding code and replications are those that made it, else a new one."""
+    """The stored table when the deciding code, the inference setting and the replications are those that made
+    it, else a new one."""
     csv, note = reports / CSV, reports / NOTE
-    wanted = {"evidence": evidence_digest(), "replications": replications, "seed": calibration.SEED}
+    wanted = {"evidence": evidence_digest(), "replications": replications, "seed": calibration.SEED,
+              "inference": INFERENCE.as_dict()}
     if not force and csv.exists() and note.exists() and json.loads(note.read_text()) == wanted:
         return read(csv)
     with tqdm(total=len(calibration.cases()), desc="calibration", unit="rule") as bar:
@@ -65,7 +68,7 @@ def failures(table: pd.DataFrame, standard_errors: float = 2.0) -> pd.DataFrame:
     """The rows of the project's rules (not the controls) whose null rate exceeds 5 % by more than
     ``standard_errors`` Monte Carlo standard errors."""
     null = table[(table["truth"] == "null") & ~table["control"].astype(bool)]
-    return null[null["rate"] > ALPHA + standard_errors * null["mc_se"]]
+    return null[null["rate"] > INFERENCE.alpha + standard_errors * null["mc_se"]]
 
 
 def draw_null_rates(table: pd.DataFrame, path: Path) -> None:
@@ -81,7 +84,7 @@ def draw_null_rates(table: pd.DataFrame, path: Path) -> None:
             colour = "tab:red" if r["control"] else plt.cm.viridis(np.log(r["runs"]) / np.log(120))
             ax.errorbar(r["rate"], y + (np.log(r["runs"]) / np.log(120) - 0.5) * 0.6, xerr=2 * r["mc_se"],
                         fmt=markers.get(r["distribution"], "o"), color=colour, ms=3, lw=0.6)
-    ax.axvline(ALPHA, color="0.3", ls="--", lw=1)
+    ax.axvline(INFERENCE.alpha, color="0.3", ls="--", lw=1)
     ax.set_yticks(range(len(rows)), rows, fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel("share of wrong decisive verdicts under the null (2 Monte Carlo SE)")
@@ -106,7 +109,7 @@ def draw_power(table: pd.DataFrame, path: Path) -> None:
                     ls={"normal": "-", "t3": "--", "lognormal": ":"}[distribution],
                     color={0.0: "tab:red", 0.5: "tab:orange", 1.0: "tab:green"}[effect],
                     label=f"{effect:g} sd, {distribution}")
-        ax.axhline(ALPHA, color="0.3", ls="--", lw=0.8)
+        ax.axhline(INFERENCE.alpha, color="0.3", ls="--", lw=0.8)
         ax.axhline(0.8, color="0.6", ls=":", lw=0.8)
         ax.set_xscale("log")
         ax.set_xlabel("runs")
@@ -131,7 +134,8 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     page.write_text(render(
         "calibration.html.j2", title="How often the verdict rules err: calibration",
         failed=failures(table), table=html_table(shown), replications=int(table["replications"].max()),
-        rows=len(table), floor=2.0 ** -5, equivalence_alpha=EQUIVALENCE_ALPHA, detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
+        rows=len(table), floor=2.0 ** -5, equivalence_alpha=INFERENCE.equivalence_alpha,
+        detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page
 
 

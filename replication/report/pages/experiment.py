@@ -2,10 +2,8 @@
 run (``runs.parquet``, ``runs.csv``) and frame (``frames.parquet``) as tidy tables
 (:mod:`replication.runner.results`)."""
 
-import json
 import platform
 import sys
-from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +11,9 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
-from replication.evidence.verdict import RULES, Verdict
+from replication.evidence.claims import Result
+from replication.evidence.schema import Summary
+from replication.evidence.settings import rules
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.evidence.claims import evaluate
@@ -70,9 +70,8 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
         for layout, folder in LAYOUTS.items():  # runs on real OTB sequences, for other toolkits to re-score
             if write_results(runs, records, out / "results", layout):
                 results.append(f"results/{folder}/")
-    compared = [entry for table in built.values() for entry in table.cells]
-    matched = {entry["published_index"] for entry in compared}
-    verdicts = Counter(Verdict.from_dict(e["verdict"]).outcome.value for e in compared if e["verdict"])
+    compared = tuple(cell for table in built.values() for cell in table.cells)
+    matched = {cell.published_index for cell in compared}
     claims = evaluate(experiment["name"], experiment, records, built, published)
     changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
@@ -98,7 +97,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)
             else None,
-            rules=RULES,
+            rules=rules(),
             claims=_claims_shown(claims),
             scale_note=scale_note(cfg.scale, changes),
             provenance=_provenance(records),
@@ -109,22 +108,9 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             versions=_versions(),
         )
     )
-    summary = {
-        "name": experiment["name"],
-        "title": experiment.get("title", experiment["name"]),
-        "paper": experiment["paper"],
-        "scale": cfg.scale,
-        "n_records": len(records),
-        "n_runs": len(runs),
-        "failed": dict(failures),
-        "verdicts": dict(verdicts),
-        "cells": compared,
-        "claims": claims,
-        "scale_changes": changes,
-        "tables": [{k: t[k] for k in ("name", "title", "csv", "note")} for t in tables],
-        "figures": figures,
-    }
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    Summary(experiment["name"], experiment.get("title", experiment["name"]), experiment["paper"], cfg.scale,
+            len(records), len(runs), dict(failures), compared, claims, tuple(changes),
+            tuple({k: t[k] for k in ("name", "title", "csv", "note")} for t in tables), tuple(figures)).write(out)
     return page
 
 
@@ -142,10 +128,9 @@ def _scenes(experiment: dict) -> list[dict]:
     return rows
 
 
-def _claims_shown(claims: dict) -> list[dict]:
+def _claims_shown(claims: dict[str, dict[str, Result]]) -> list[dict]:
     """Each claim reading tested on this experiment, with its checks, for the page."""
-    return [{"id": claim, "reading": reading, "verdict": Verdict.from_dict(result["verdict"]),
-             "checks": [{**c, "verdict": Verdict.from_dict(c["verdict"])} for c in result["checks"]]}
+    return [{"id": claim, "reading": reading, "verdict": result.verdict, "checks": result.checks}
             for claim, readings in claims.items() for reading, result in readings.items()]
 
 

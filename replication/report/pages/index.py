@@ -18,8 +18,9 @@ from replication.evidence.published import load_published
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
+from replication.evidence.schema import Summary
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table
-from replication.evidence.verdict import RULES
+from replication.evidence.settings import rules
 
 TITLE = "Particle-filter tracking papers: replication report"
 
@@ -29,9 +30,9 @@ def default_published_values() -> Path:
     return resolve(OmegaConf.load(CONF_DIR / "config.yaml").published_values)
 
 
-def _scale_note(summaries: dict[str, dict]) -> str | None:
+def _scale_note(summaries: dict[str, Summary]) -> str | None:
     """The banner when any stored report is below the paper's scale (each experiment's page lists its changes)."""
-    quick = [name for name, s in summaries.items() if s.get("scale") != "paper"]
+    quick = [name for name, s in summaries.items() if s.scale != "paper"]
     if not quick:
         return None
     return (f"{len(quick)} of {len(summaries)} experiments are at the quick scale. {scale_note('quick')} "
@@ -46,10 +47,12 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
         if name not in summaries:
             missing.append(name)
             continue
-        entry = dict(summaries[name])
-        entry["verdicts"] = ", ".join(f"{k}: {v}" for k, v in sorted(entry["verdicts"].items())) or "-"
-        entry["ablation"] = "ablation" in name  # the studies on top of the papers get their own section
-        entry["multiverse"] = "multiverse" in entry  # so do the papers' readings
+        summary = summaries[name]
+        entry = {"name": name, "title": summary.title, "paper": summary.paper, "scale": summary.scale,
+                 "n_records": summary.n_records, "n_runs": summary.n_runs, "failed": summary.failed,
+                 "verdicts": ", ".join(f"{k}: {v}" for k, v in sorted(summary.verdicts.items())) or "-",
+                 "ablation": "ablation" in name,  # the studies on top of the papers get their own section
+                 "multiverse": bool(summary.multiverse)}  # so do the papers' readings
         experiments.append(entry)
     published = load_published(str(resolve(published_values or default_published_values())))
     papers = load_papers()
@@ -71,7 +74,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
                      "cells": int((cells["paper"] == paper.key).sum())} for paper in papers],
             scale_note=_scale_note(summaries),
             tallies=tallies,
-            rules=RULES,
+            rules=rules(),
             counts=counts(cells, summaries),
             benchmark=(reports / "benchmark" / "index.html").exists(),
             calibration=(reports / "calibration" / "index.html").exists(),

@@ -7,7 +7,8 @@ the configs.
 """
 
 from replication.evidence.inference import detectable
-from replication.evidence.verdict import MIN_RUNS
+from replication.evidence.settings import INFERENCE
+
 
 PAPER_COMMAND = "make replicate SCALE=paper"
 SCALED = ("runs", "scenes", "model", "methods")  # where a config's scale takes effect (not its YAML anchors)
@@ -42,8 +43,8 @@ def scale_note(scale: str, changes: list[str] | None = None) -> str | None:
         return None
     listed = "" if changes is None else f" ({'; '.join(changes) or 'for this experiment, nothing'})"
     return (f"Quick scale: fewer runs and shorter scenes than the papers'{listed}. Intervals are wider, "
-            f"verdicts from fewer than {MIN_RUNS} runs are 'not testable', and a ranking over sequences cut short is "
-            f"marked not reliable and decides no claim (a full-length ranking can differ). With {MIN_RUNS} paired runs "
-            f"an exact test reaches p = 1/{2 ** MIN_RUNS} at best, and a paired t-test finds an effect of "
-            f"{detectable(1.0, MIN_RUNS):.2g} standard deviations with 80% power: most claims are then inconclusive, "
-            f"which is what {MIN_RUNS} runs can say. Paper scale: {PAPER_COMMAND}.")
+            f"verdicts from fewer than {INFERENCE.min_runs} runs are 'not testable', and a ranking over sequences cut short is "
+            f"marked not reliable and decides no claim (a full-length ranking can differ). With {INFERENCE.min_runs} paired runs "
+            f"an exact test reaches p = 1/{2 ** INFERENCE.min_runs} at best, and a paired t-test finds an effect of "
+            f"{detectable(1.0, INFERENCE.min_runs):.2g} standard deviations with 80% power: most claims are then inconclusive, "
+            f"which is what {INFERENCE.min_runs} runs can say. Paper scale: {PAPER_COMMAND}.")

@@ -1,0 +1,1 @@
+"""Deciding: quantities, intervals, tests, verdicts, claims, tables, rankings and robustness, from run records."""
