@@ -311,6 +311,38 @@ def test_failure_of_all_targets_or_of_the_key_target():
     assert "failed[target3]" not in multi_target_scores({}, estimates, truth, np.ones((20, 3)), [0, 1, 2])
 
 
+def test_three_readings_of_failure_on_a_swap_and_a_loss_of_lock():
+    """Two balls 100 px apart.  Their estimates swap for 12 frames: lost (each 100 px off its own) and a
+    persistent swap, but never off every ball.  Then ball 1's estimate wanders 30 px into empty space for 12
+    frames: lost and lock lost, no swap.  9 frames of either fail nothing (K = 10)."""
+    from replication.tasks.tracking import multi_target_scores
+
+    truth = np.zeros((40, 2, 4))
+    truth[:, :, 2:] = 20
+    truth[:, 1, 0] = 100
+    evaluation = {"loss_threshold": 20.0, "loss_patience": 10}
+
+    def scores(estimates):
+        return multi_target_scores(evaluation, estimates, truth, np.ones((40, 2)), [0, 1])
+
+    swap = truth.copy()
+    swap[5:17, :, 0] = swap[5:17, ::-1, 0]
+    found = scores(swap)
+    assert (found["failed"], found["failed[swap]"], found["failed[drift]"]) == (1.0, 1.0, 0.0)
+    assert found["error_without_failure[drift]"] == found["mean_error_per_target"] > 0
+    assert np.isnan(found["error_without_failure[swap]"]) and np.isnan(found["error_without_failure[lost]"])
+    drift = truth.copy()
+    drift[20:32, 0, 1] += 30
+    found = scores(drift)
+    assert (found["failed"], found["failed[swap]"], found["failed[drift]"]) == (1.0, 0.0, 1.0)
+    short = truth.copy()
+    short[5:14, :, 0] = short[5:14, ::-1, 0]
+    short[20:29, 0, 1] += 30
+    found = scores(short)
+    assert (found["failed"], found["failed[swap]"], found["failed[drift]"]) == (0.0, 0.0, 0.0)
+    assert found["error_without_failure[swap]"] == found["mean_error_per_target"]
+
+
 def _on_still_balls(method: str, *overrides: str) -> dict:
     """``method`` of bis_pf on its 16 balls held still (no noise, speed 0) for 100 frames."""
     from hydra import compose, initialize_config_dir

@@ -198,3 +198,32 @@ def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypa
     monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
     figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")
     assert seen == [["scene=b"]]
+
+
+def test_the_encounter_strip_marks_a_swap_where_the_per_identity_error_jumps(drawn, monkeypatch, tmp_path):
+    """Two balls cross; method A's estimates follow each other's ball from frame 16 on, B's stay.  A's strip
+    has one red tick at frame 16 on the one pair that met, B's none; the off-image curve counts nothing."""
+    from types import SimpleNamespace
+
+    frames = np.arange(30)
+    truth = np.zeros((30, 2, 4))
+    truth[..., 2:] = 20
+    truth[:, 0, 0], truth[:, 1, 0], truth[..., 1] = frames * 3.0, 90 - frames * 3.0, 50
+    swapped = truth.copy()
+    swapped[16:] = truth[16:, ::-1]
+    monkeypatch.setattr(tracking_figures, "sequence_seen",
+                        lambda experiment, runs: SimpleNamespace(truth=truth, size=(200, 100)))
+    records = typed(pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": 0,
+                                   "per_frame": {"box": boxes.tolist(), "targets": [0, 1]}}
+                                  for m, boxes in (("A", swapped), ("B", truth))]))
+    experiment = {"methods": {"A": {}, "B": {}}}
+    figures.draw(records, {"name": "e", "kind": "encounter_strip", "distance": 20.0}, experiment, tmp_path / "e.png")
+    fig = drawn[-1]
+    strips = fig.axes[1::2]
+    ticks = [[line.get_xdata()[0] for line in ax.get_lines() if to_hex(line.get_color()) == to_hex("C3")]
+             for ax in strips]
+    assert ticks == [[16, 16], []]  # both estimates of the pair start on the other ball at frame 16
+    per_identity = next(line for line in fig.axes[0].get_lines() if line.get_label() == "per identity")
+    assert per_identity.get_ydata()[15] < 20 < per_identity.get_ydata()[20]
+    figures.draw(records, {"name": "o", "kind": "outside_curve"}, experiment, tmp_path / "o.png")
+    assert all((line.get_ydata() == 0).all() for line in drawn[-1].axes[0].get_lines())

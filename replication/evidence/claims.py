@@ -182,7 +182,7 @@ class ClaimTest:
 class Order(ClaimTest):
     """``order: [A, [B, C], D]``: A beats B and C, each of which beats D, on ``metric``, at each condition.
 
-    Each pair is a check on the runs that filtered the same data
+    Each pair is a check on the runs that filtered the same data and where both methods' metric is defined
     (:func:`~replication.evidence.comparisons.order_test`): Student's paired
     t-test (McNemar's exact test for yes/no outcomes) in the claimed direction,
     and, where ``size:`` names the paper's table, the paper's own gap between
@@ -203,6 +203,7 @@ class Order(ClaimTest):
             for better, worse in zip(groups, groups[1:]):
                 for a, b in itertools.product(better, worse):
                     paired = pair(records, metric, b, a, condition)
+                    paired = paired[np.isfinite(paired[["baseline", "method"]]).all(axis=1)]  # both defined
                     what = f"{a} - {b}" + (f" at {condition}" if condition else "")
                     if paired.empty:
                         continue

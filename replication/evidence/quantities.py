@@ -97,6 +97,9 @@ _PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_t
     (re.compile(r"tracked_to_end\[(.+)\]"), lambda rule: replace(_BINARY, lower_is_better=False,
                                                                  label=f"runs tracked to the end ({rule})")),
     (re.compile(r"ospa\[c=(.+)\]"), lambda cutoff: Quantity("positive", label=f"OSPA, cut off at {cutoff} px")),
+    (re.compile(r"failed\[(.+)\]"), lambda reading: replace(_BINARY, label=f"runs failed ({reading})")),
+    (re.compile(r"error_without_failure\[(.+)\]"),
+     lambda reading: Quantity("positive", label=f"mean error per target, runs without failure ({reading}) (px)")),
 )
 
 

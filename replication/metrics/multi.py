@@ -56,16 +56,45 @@ def close_encounters(truth: np.ndarray, distance: float) -> int:
     return int(np.triu(starts, k=1).sum() + np.triu(close[0], k=1).sum())
 
 
+def persistent_onsets(flags: np.ndarray, patience: int) -> np.ndarray:
+    """(M,) per target (column of ``flags``, frames x targets), the first frame of its first run of ``patience``
+    True frames in a row, or the number of frames where there is none."""
+    flags = np.asarray(flags, dtype=bool)
+    run = np.zeros(flags.shape[1], dtype=int)
+    onset = np.full(flags.shape[1], len(flags))
+    for k, row in enumerate(flags):
+        run = np.where(row, run + 1, 0)
+        onset = np.where((run >= patience) & (onset == len(flags)), k - patience + 1, onset)
+    return onset
+
+
 def loss_onsets(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
     """(M,) the frame at which each target's first loss begins (the first of ``patience`` frames in a row
     over ``threshold`` px from it), or the number of frames for a target never lost."""
-    far = np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1) > threshold
-    run = np.zeros(far.shape[1], dtype=int)
-    onset = np.full(far.shape[1], len(far))
-    for k, row in enumerate(far):
-        run = np.where(row, run + 1, 0)
-        onset = np.where((run >= patience) & (onset == len(far)), k - patience + 1, onset)
-    return onset
+    return persistent_onsets(np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1) > threshold, patience)
+
+
+def assignments(estimates: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(frames, M) the target each estimate is given by the frame's optimal assignment (Hungarian over centre
+    distances), and its distance to that target."""
+    distances = _pairwise(estimates, truth)
+    assigned = np.zeros(distances.shape[:2], dtype=int)
+    for k, frame in enumerate(distances):
+        rows, columns = linear_sum_assignment(frame)
+        assigned[k, rows] = columns
+    return assigned, np.take_along_axis(distances, assigned[..., None], axis=-1)[..., 0]
+
+
+def swapped(estimates: np.ndarray, truth: np.ndarray, threshold: float) -> np.ndarray:
+    """(frames, M) bool: estimate m sits on another target, the one the frame's optimal assignment gives it,
+    within ``threshold`` px: an identity swap, not a loss of lock."""
+    assigned, distance = assignments(estimates, truth)
+    return (assigned != np.arange(assigned.shape[1])) & (distance <= threshold)
+
+
+def off_every_target(estimates: np.ndarray, truth: np.ndarray, threshold: float) -> np.ndarray:
+    """(frames, M) bool: estimate m lies over ``threshold`` px from every target: lock lost, whoever it was on."""
+    return _pairwise(estimates, truth).min(axis=-1) > threshold
 
 
 def track_losses(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:

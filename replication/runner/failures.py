@@ -27,6 +27,9 @@ UNDEFINED = {  # metric: when it is undefined, and so stored as NaN (or inf) wit
     "fps": "MOT: a tracker timed at 0 s runs at infinitely many frames per second",
     "swaps_per_encounter": "tracking: no two targets came within a box width of each other",
     "tracked_error": "tracking: every target was lost from the first frame judged",
+    "error_without_failure[lost]": "tracking: the run failed by that reading (Table 2 averages runs without failure)",
+    "error_without_failure[swap]": "tracking: the run failed by that reading (Table 2 averages runs without failure)",
+    "error_without_failure[drift]": "tracking: the run failed by that reading (Table 2 averages runs without failure)",
 }
 FAILED_STATUS = 3  # the run command's exit status when runs failed (2: a bad request; 130, 143: interrupted)
 SHOWN = 3  # numbers named in a reason

@@ -111,22 +111,35 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
     when any target is lost (``failed``); with ``key_target`` (a scene target,
     0-based) it also says whether that one is (``failed[target<k + 1>]``: the
     3123 test's success is target 3 picked up again, section 3.1).
+
+    The paper never defines failure, so two other readings are recorded with the same ``loss_threshold`` and
+    ``loss_patience`` K: ``failed[swap]``, an estimate that sits on another target (the frame's optimal
+    assignment) for K visible frames in a row, an identity swap that persists; ``failed[drift]``, an
+    estimate over the threshold from every target for K visible frames, lock lost whoever it was on.
+    ``error_without_failure[lost|swap|drift]`` is the mean error per target of a run that does not fail by
+    that reading (NaN where it does): Table 2 averages "runs without failure".
     """
     threshold = evaluation.get("loss_threshold", 20.0)
     start = max(int(evaluation.get("from_frame", 2)) - 1, 1)
     estimated, true = tm.centres(estimates), tm.centres(truth)
     errors = np.linalg.norm(estimated - true, axis=-1)[start:]
     visible = visibility[start:] >= 0.5
+    patience = evaluation.get("loss_patience", 10)
     onsets = multi.loss_onsets(np.where(visible[..., None], estimated[start:], true[start:]), true[start:], threshold,
-                               evaluation.get("loss_patience", 10))
+                               patience)
     lost = onsets < len(visible)
+    failures = {"swap": multi.swapped(estimated[start:], true[start:], threshold),
+                "drift": multi.off_every_target(estimated[start:], true[start:], threshold)}
+    failed = {"lost": bool(lost.any()), **{name: bool((multi.persistent_onsets(flags & visible, patience)
+                                                       < len(visible)).any()) for name, flags in failures.items()}}
+    error = multi.mean_error_per_target(estimated[1:], true[1:])
     mot = multi.clear_mot(true[1:], estimated[1:], threshold, visibility[1:] >= 0.5)
     encounters = multi.close_encounters(true[1:], threshold)
     key = {}
     if "key_target" in evaluation:
         key[f"failed[target{evaluation['key_target'] + 1}]"] = float(lost[chosen.index(evaluation["key_target"])])
     return {
-        "mean_error_per_target": multi.mean_error_per_target(estimated[1:], true[1:]),
+        "mean_error_per_target": error,
         "identity_free_error": multi.identity_free_error(estimated[1:], true[1:]),
         f"ospa[c={threshold:g}]": multi.ospa(estimated[1:], true[1:], threshold),
         "tracked_error": multi.tracked_error(estimated[start:], true[start:], onsets),
@@ -134,6 +147,8 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
         "swaps_per_encounter": mot["switches"] / encounters if encounters else float("nan"),
         "lost_targets": int(lost.sum()),
         "failed": float(lost.any()),
+        **{f"failed[{name}]": float(value) for name, value in failed.items() if name != "lost"},
+        **{f"error_without_failure[{name}]": float("nan") if value else error for name, value in failed.items()},
         "switches": mot["switches"],
         "mota": mot["mota"],
         "visible_error": float(errors[visible].mean()) if visible.any() else float("nan"),

@@ -15,11 +15,10 @@ The hypotheses come from the video each run saw (its ``scene_seed``).
 import numpy as np
 import pandas as pd
 
-from replication.evidence.aggregate import scene_of
+from replication.evidence.aggregate import sequence_seen
 from replication.evidence.statistics import proportion
 from replication.evidence.tables.table import Table, TableKind, match
 from replication.evidence.verdict import judge_band
-from replication.scenes.factory import cached_sequence
 
 
 def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, width: float, mass: float) -> float:
@@ -39,11 +38,9 @@ def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
-    scene = experiment["scenes"][scene_of(experiment, group)]
     shares = []
-    for _, run in group.iterrows():
-        seed = run.get("scene_seed")
-        sequence = cached_sequence(scene if seed is None or pd.isna(seed) else {**scene, "seed": int(seed)})
+    for index, run in group.iterrows():
+        sequence = sequence_seen(experiment, group.loc[[index]])
         axis = "xy".index(run["strip"]["axis"])
         truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
         hypotheses = truth[..., axis] + truth[..., axis + 2] / 2

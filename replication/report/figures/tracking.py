@@ -8,12 +8,13 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import to_rgb
 
-from replication.evidence.aggregate import scene_of
+from replication.evidence.aggregate import scene_of, sequence_seen
 from replication.evidence.attributes import absent, attribute_scores
+from replication.metrics import multi
+from replication.metrics.tracking import centres
 from replication.report.figures.style import (
     NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
 )
-from replication.scenes.factory import cached_sequence
 from replication.report.figures.base import figure
 
 
@@ -75,9 +76,8 @@ def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
 
 
 def _sequence(experiment: dict, condition_records: pd.DataFrame):
-    """The sequence of a condition's runs and the targets they track."""
-    name = scene_of(experiment, condition_records)
-    return cached_sequence(experiment["scenes"][name]), condition_records["per_frame"].iloc[0]["targets"]
+    """The video a condition's first runs saw (one per method, the same repetition) and the targets they track."""
+    return sequence_seen(experiment, condition_records), condition_records["per_frame"].iloc[0]["targets"]
 
 
 @figure("track")
@@ -266,4 +266,67 @@ def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Pat
     missing = absent(scores)
     if missing:
         axes[-1, 0].set_xlabel(f"no sequence here carries {', '.join(missing)}", fontsize=7)
+    return save(fig, path)
+
+
+@figure("encounter_strip")
+def encounter_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """Why the per-identity error grows, for the first run of each method: above, its per-identity and
+    identity-free error per frame; below, one row per pair of targets that comes within ``spec.distance`` px
+    (a box width) of each other, grey while they are that close, a red tick where an estimate starts to sit
+    on the other target of the pair (the frame's optimal assignment): an identity swap."""
+    distance = spec.get("distance", 20.0)
+    runs = _first_runs(records)
+    sequence, chosen = _sequence(experiment, records)
+    truth = centres(sequence.truth[:, chosen])
+    apart = np.linalg.norm(truth[:, :, None] - truth[:, None, :], axis=-1)
+    pairs = [(i, j) for i, j in zip(*np.triu_indices(len(chosen), 1)) if (apart[:, i, j] < distance).any()]
+    if not pairs:
+        raise NothingToDraw(f"figure {spec.get('name')!r}: no two targets come within {distance:g} px")
+    row_of = {pair: k for k, pair in enumerate(sorted(pairs, key=lambda p: np.argmax(apart[:, p[0], p[1]] < distance)))}
+    frames = np.arange(len(truth))
+    fig, axes = plt.subplots(2 * len(runs), 1, figsize=(10, len(runs) * (1.6 + 0.05 * len(pairs))), squeeze=False,
+                             gridspec_kw={"height_ratios": [1, max(1.5, 0.05 * len(pairs))] * len(runs)}, sharex=True)
+    for (_, run), top, strip in zip(runs.iterrows(), axes[0::2, 0], axes[1::2, 0]):
+        estimates = centres(np.array(run["per_frame"]["box"], dtype=float))
+        assigned, near = multi.assignments(estimates, truth)
+        top.plot(frames, np.linalg.norm(estimates - truth, axis=-1).mean(axis=1), color="C3", lw=1,
+                 label="per identity")
+        top.plot(frames, near.mean(axis=1), color="C0", lw=1, label="identity-free")
+        top.set_ylabel("error (px)", fontsize=7)
+        top.set_title(method_label(experiment, run["method"]), fontsize=9, loc="left")
+        top.legend(fontsize=6, loc="upper left")
+        for (i, j), row in row_of.items():
+            close = apart[:, i, j] < distance
+            strip.fill_between(frames, row - 0.4, row + 0.4, where=close, color="0.75", step="mid", lw=0)
+        on_other = (assigned != np.arange(len(chosen))) & (near <= distance)
+        starts = on_other & ~np.vstack([np.zeros((1, len(chosen)), bool), on_other[:-1]])
+        for k, m in zip(*np.nonzero(starts)):
+            row = row_of.get(tuple(sorted((int(m), int(assigned[k, m])))))
+            if row is not None:
+                strip.plot([k, k], [row - 0.45, row + 0.45], color="C3", lw=1.2)
+        strip.set_ylim(-0.5, len(pairs) - 0.5)
+        strip.set_yticks([])
+        strip.set_ylabel(f"{len(pairs)} pairs", fontsize=7)
+    axes[-1, 0].set_xlabel("frame")
+    return save(fig, path)
+
+
+@figure("outside_curve")
+def outside_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """Per frame, the share of targets whose estimated centre lies outside the image (the filter's own state,
+    never clipped), mean over runs, per method: a tracker that runs off the frame shows it here."""
+    sequence, _ = _sequence(experiment, records)
+    width, height = sequence.size
+    fig, ax = plt.subplots(figsize=(7, 2.8))
+    for method, runs in records.groupby("method", sort=False):
+        points = np.array([centres(np.array(r["box"], dtype=float)) for r in runs["per_frame"]])  # runs, T, M, 2
+        outside = (points < 0).any(axis=-1) | (points[..., 0] >= width) | (points[..., 1] >= height)
+        ax.plot(np.arange(outside.shape[1]), outside.mean(axis=(0, 2)), **method_look(method).line(),
+                markevery=max(1, outside.shape[1] // 12), markersize=4, lw=1.2,
+                label=method_label(experiment, method))
+    ax.set_xlabel("frame")
+    ax.set_ylabel("share of estimates\noutside the image")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
     return save(fig, path)

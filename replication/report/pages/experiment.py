@@ -24,6 +24,7 @@ from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
 from replication.run import Run
+from replication.scenes.factory import cached_sequence
 from replication.runner.config import experiment_at_scale
 from replication.runner.results import frames, tidy, write
 from replication.runner.store import Store
@@ -90,7 +91,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             n_failed=failures.total(),
             tables=tables,
             files=files,
-            scenes=_scenes(experiment),
+            scenes=_scenes(experiment, OmegaConf.to_container(cfg.experiment, resolve=True)),
             figures=figures,
             left_out=left_out,
             results=results,
@@ -114,18 +115,38 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
     return page
 
 
-def _scenes(experiment: dict) -> list[dict]:
-    """What each scene of a tracking experiment is: real video, or a synthetic stand-in and for what."""
+REAL = {"otb": "OTB", "mot": "MOTChallenge"}  # scene kinds that are real video, by their benchmark
+
+
+def _scenes(experiment: dict, written: dict) -> list[dict]:
+    """What each scene of a tracking experiment is: real video, or a synthetic stand-in and for what; for a
+    stand-in whose length depends on the scale, whether the quick video is the start of the paper's."""
     rows = []
     for name, spec in experiment.get("scenes", {}).items():
-        if spec.get("kind", "synthetic") == "otb":
-            frames = f"frames {spec.get('first', 0) + 1}-{spec['last']}" if spec.get("last") else "all frames"
-            rows.append({"name": name, "kind": "real video (OTB)", "what": f"OTB sequence {spec['name']}, {frames}"})
+        kind = spec.get("kind", "synthetic")
+        if kind in REAL:
+            first = spec.get("first", 0) + (kind == "otb")  # OTB's first is 0-based, MOTChallenge's 1-based
+            frames = f"frames {first}-{spec['last']}" if spec.get("last") else "all frames"
+            rows.append({"name": name, "kind": f"real video ({REAL[kind]})",
+                         "what": f"{REAL[kind]} sequence {spec['name']}, {frames}"})
         else:
             size = "x".join(str(v) for v in spec.get("size", []))
             what = spec.get("stand_in") or "synthetic scene"
-            rows.append({"name": name, "kind": "synthetic stand-in", "what": f"{what} ({size}, {spec.get('frames')} frames)"})
+            rows.append({"name": name, "kind": "synthetic stand-in",
+                         "what": f"{what} ({size}, {spec.get('frames')} frames){_prefix(written['scenes'][name])}"})
     return rows
+
+
+def _prefix(scene: dict) -> str:
+    """Whether the quick scale's video of a scene is the first frames of the paper scale's (same seed)."""
+    frames = scene.get("frames")
+    if not isinstance(frames, dict) or not {"quick", "paper"} <= set(frames):
+        return ""
+    short, long = (cached_sequence({**scene, "frames": frames[s]}) for s in ("quick", "paper"))
+    same = np.array_equal(short.truth, long.truth[: len(short.truth)])
+    return (f"; the quick scale's {frames['quick']} frames are {'' if same else 'not '}the first "
+            f"{frames['quick']} of the paper scale's {frames['paper']}" + ("" if same else
+                                                                            " (another random walk from the same seed)"))
 
 
 def _claims_shown(claims: dict[str, dict[str, Result]]) -> list[dict]:
