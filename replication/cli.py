@@ -135,14 +135,19 @@ def run_experiment(cfg: DictConfig) -> None:
     from replication.runner.failures import exit_if_failed
     from replication.runner.store import Store
     from replication.runner.validate import prepare
+    from replication.runner.variant import differences, report_name
 
     if "multiverse" in cfg.experiment:
         return run_multiverse(cfg)
     try:
         runs, skipped, (backend, n_jobs, address) = prepare(cfg)
         configure(cfg.inference)  # before any run: a mistyped setting fails now, not after hours of runs
+        reported_as = report_name(cfg, differences(cfg))  # a bad label fails now too
     except ConfigError as error:
         fail(str(error))
+    if reported_as != cfg.experiment.name:
+        print(f"{cfg.experiment.name}: this request changes the shipped experiment (your data or settings): "
+              f"reported as {reported_as}, judging no paper claim")
     for message in skipped:
         print(f"skipped: {message}", file=sys.stderr)
     store = Store(resolve(cfg.store), cfg.experiment.name)
@@ -152,11 +157,19 @@ def run_experiment(cfg: DictConfig) -> None:
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}")
         from replication.report.pages.experiment import write_experiment_report
         from replication.report.pages.index import write_index
+        from hydra.core.hydra_config import HydraConfig
 
-        written = write_experiment_report(cfg, runs, store)
+        from replication.runner.results import Results
+
+        results = Results.of(cfg, runs, store, tuple(HydraConfig.get().overrides.task))
+        written = write_experiment_report(cfg, results)
         index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
         print(f"{cfg.experiment.name}: report in {written}; index in {index}")
-        run_companions(cfg)
+        if results.own and cfg.experiment.get("also"):
+            print(f"skipped: {', '.join(cfg.experiment.also)}, run beside {cfg.experiment.name} as shipped, since "
+                  "this request changes it (your data or settings); run one by name if you want it", file=sys.stderr)
+        else:
+            run_companions(cfg)
         exit_if_failed(store, runs)
     except BackendError as error:
         fail(str(error))
@@ -188,10 +201,12 @@ def run_multiverse(cfg: DictConfig) -> None:
             store, runs = Store(resolve(cfg.store), experiment), multiverse.runs_of(experiment)
             done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
             print(f"{name}: {experiment}: {done} runs computed, {len(runs) - done} already stored")
+        from hydra.core.hydra_config import HydraConfig
+
         from replication.report.pages.index import write_index
         from replication.report.pages.multiverse import write_multiverse_report
 
-        written = write_multiverse_report(cfg, multiverse)
+        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
     except BackendError as error:

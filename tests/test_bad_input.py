@@ -198,14 +198,25 @@ def test_the_intact_copy_passes(tmp_path):
 
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
-def test_a_users_own_sequences_run_through_an_experiment(tmp_path):
-    """``data.otb=<folder> sequences=[...]``: the experiment's methods on the user's sequences alone."""
-    girl = girl_copy(tmp_path)
+def test_a_users_own_sequences_get_their_own_report_and_leave_the_scorecard_alone(tmp_path):
+    """``data.otb=<folder> sequences=[...]`` on a copy of a shipped sequence under another name: the
+    experiment's methods on it alone, reported as hspf@mine with what differs, no companion run, and
+    claims.csv byte-identical before and after."""
+    from replication.report.pages.index import write_index
+
+    clip = girl_copy(tmp_path).rename(tmp_path / "otb" / "MyClip")
+    before = (write_index(tmp_path / "reports").parent / "claims.csv").read_bytes()
     result, _ = request(tmp_path, "experiment=hspf", "scale=quick", "experiment.runs.quick=1",
-                        f"data.otb={girl.parent}", "sequences=[Girl]")
+                        f"data.otb={clip.parent}", "sequences=[MyClip]", "label=mine")
     assert result.returncode == 0, result.stderr
     records = list((tmp_path / "experiments" / "hspf" / "runs").glob("*.json"))
-    assert records and all('"scene=Girl"' in r.read_text() or "scene=Girl" in r.read_text() for r in records)
+    assert records and all("scene=MyClip" in r.read_text() for r in records)
+    assert (tmp_path / "reports" / "claims.csv").read_bytes() == before
+    assert not (tmp_path / "reports" / "hspf").exists() and not (tmp_path / "reports" / "hspf_ungm").exists()
+    assert "skipped: hspf_ungm" in result.stderr
+    page = (tmp_path / "reports" / "hspf@mine" / "index.html").read_text()
+    assert "Not the paper's experiment" in page and "scenes.MyClip: added" in page and "sequences=[MyClip]" in page
+    assert 'href="hspf@mine/index.html"' in (tmp_path / "reports" / "index.html").read_text()
 
 
 @pytest.mark.parametrize(

@@ -42,7 +42,7 @@ def test_a_run_stopped_by_nan_log_weights_fails_with_the_reason(make_cfg):
 def test_failed_runs_are_recorded_counted_and_not_rerun(cli, tmp_path):
     """A variance so large that the grid filter's posterior overflows to NaN: its runs fail, the others
     are stored; the command says so and exits 3, the report counts them, a rerun computes nothing."""
-    args = ("experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=2", "experiment.model.Q=1e200")
+    args = ("experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=2", "experiment.model.Q=1e200", "label=huge_q")
     line = "failed: 2 runs of hspf_ungm: not finite: rmse=nan"
     result = cli(*args)
     assert result.returncode == FAILED_STATUS, result.stderr
@@ -53,7 +53,7 @@ def test_failed_runs_are_recorded_counted_and_not_rerun(cli, tmp_path):
     assert [p.name.split("__")[0] for p in failed] == ["grid", "grid"] and len(list(runs.glob("*.json"))) == 4
     assert {p.read_text() for p in failed} == {"not finite: rmse=nan\n"}
 
-    report = tmp_path / "reports" / "hspf_ungm"
+    report = tmp_path / "reports" / "hspf_ungm@huge_q"  # not the experiment as shipped: a report of its own
     assert "2 runs failed: not finite: rmse=nan" in (report / "index.html").read_text()
     assert json.loads((report / "summary.json").read_text())["failed"] == {"not finite: rmse=nan": 2}
     table = pd.read_csv(report / "table1_rmse.csv")  # PF and HSPF from their 2 runs each, no grid row

@@ -135,7 +135,8 @@ def detectable(sd: float, runs: int) -> float:
     over ``runs`` runs detects with probability :data:`INFERENCE.power` (the normal-theory approximation)."""
     if runs < 2 or not np.isfinite(sd):
         return float("nan")
-    return float((stats.t.ppf(1 - INFERENCE.alpha, runs - 1) + stats.t.ppf(INFERENCE.power, runs - 1)) * sd / np.sqrt(runs))
+    quantiles = stats.t.ppf(1 - INFERENCE.alpha, runs - 1) + stats.t.ppf(INFERENCE.power, runs - 1)
+    return float(quantiles * sd / np.sqrt(runs))
 
 
 def said_p(p: float) -> str:

@@ -50,6 +50,7 @@ class Summary:
     tables: tuple[dict[str, str], ...] = ()  # name, title, csv, note
     figures: tuple[dict[str, str], ...] = ()  # name, title, file (and link, beside)
     multiverse: dict[str, RobustnessResult] = dataclasses.field(default_factory=dict)
+    own: tuple[str, ...] = ()  # what a user's request changed in the shipped experiment (empty: as shipped)
 
     @property
     def verdicts(self) -> dict[str, int]:

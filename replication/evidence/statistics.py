@@ -68,7 +68,8 @@ def proportion(successes: int, runs: int) -> Estimate:
     """The share of runs with an outcome and its exact Clopper-Pearson interval."""
     if runs == 0:
         return Estimate(math.nan, math.nan, math.nan, 0, "Clopper-Pearson")
-    interval = stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=INFERENCE.level, method="exact")
+    interval = stats.binomtest(int(successes), int(runs)).proportion_ci(confidence_level=INFERENCE.level,
+                                                                        method="exact")
     return Estimate(successes / runs, float(interval.low), float(interval.high), int(runs), "Clopper-Pearson")
 
 

@@ -25,11 +25,14 @@ from replication.paths import CONF_DIR, experiment_names
 # -- the summary of every published cell --------------------------------------------------------------
 
 
-def load_summaries(reports: Path) -> dict[str, Summary]:
-    """Each experiment's ``summary.json`` under ``reports``, by experiment name (configs' order).  One that
-    an older version wrote in another schema is left out with one line on stderr (redraw it)."""
+def load_summaries(reports: Path, own: bool = False) -> dict[str, Summary]:
+    """Each shipped experiment's ``summary.json`` under ``reports``, by experiment name (configs' order); with
+    ``own``, instead the reports of users' own data or settings (``<experiment>@<label>``), which the
+    scorecard and the summary of published cells never read.  One that an older version wrote in another
+    schema is left out with one line on stderr (redraw it)."""
     summaries = {}
-    for name in experiment_names():
+    names = sorted(p.parent.name for p in Path(reports).glob("*@*/summary.json")) if own else experiment_names()
+    for name in names:
         path = Path(reports) / name / "summary.json"
         if not path.exists():
             continue

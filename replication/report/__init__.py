@@ -1,1 +1,1 @@
-"""Drawing: the figures, the HTML pages and the PDF of what replication.evidence decides; reads only the result store."""
+"""Drawing: the figures, the HTML pages and the PDF of what replication.evidence decides."""

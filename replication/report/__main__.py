@@ -24,6 +24,7 @@ from replication.report.pages.multiverse import write_multiverse_report
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
+from replication.runner.results import Results
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
@@ -67,9 +68,10 @@ def main(argv: list[str]) -> None:
             try:
                 configure(cfg.inference)
                 if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
-                    page = write_multiverse_report(cfg, load_multiverse(cfg))
+                    page = write_multiverse_report(cfg, load_multiverse(cfg), tuple(overrides))
                 else:
-                    page = write_experiment_report(cfg, expand(cfg), Store(resolve(cfg.store), name))
+                    results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
+                    page = write_experiment_report(cfg, results)
             except ConfigError as error:
                 fail(str(error))
             print(f"{name}: {page}")
@@ -117,9 +119,10 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
                      f"python -m replication -m experiment={name} {' '.join(overrides)} {sweep}")
             command = " ".join(["python -m replication.report", f"experiment={name}", *overrides, f"sweep={sweep}"]
                                + ([f"metric={metric}"] if metric else []))
+            results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
-                                      resolve(cfg.reports) / name / "sweeps", missing, command)
-            write_experiment_report(cfg, expand(cfg), Store(resolve(cfg.store), name))  # now linking the sweep
+                                      resolve(cfg.reports) / results.name / "sweeps", missing, command)
+            write_experiment_report(cfg, results)  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])
     for line in missing:

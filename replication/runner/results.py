@@ -20,24 +20,70 @@ errors; :func:`replication.tasks.mot.frame_table`: a row per track, its box).  J
     frames = load_frames("hspf", scale="quick")
     sns.lineplot(frames, x="frame", y="cle", hue="method", units="run_key", estimator=None)
 
-The report writes both (:func:`write`) as ``reports/<experiment>/runs.parquet`` with
-``runs.csv``, and ``frames.parquet`` (no CSV: up to a million rows at paper scale).
+A report is drawn from one :class:`Results` (:meth:`Results.of`: the experiment's config at its scale,
+its runs, their stored records and the failures' reasons), which also writes both tables
+(:meth:`Results.write_tables`) as ``reports/<experiment>/runs.parquet`` with ``runs.csv``, and
+``frames.parquet`` (no CSV: up to a million rows at paper scale).
 """
 
 import json
+from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 from hydra import compose, initialize_config_dir
+from omegaconf import DictConfig
 
 from replication.paths import CONF_DIR, resolve
 from replication.run import Run
-from replication.runner.config import expand
+from replication.runner.config import expand, experiment_at_scale
 from replication.runner.store import Store
+from replication.runner.variant import differences, report_name
 from replication.tasks import TASKS
 
 SERIES = ("per_frame", "strip", "tracks")  # per-frame data, kept in the records
 IDENTITY = ("experiment", "method", "condition", "repetition", "run_key")
+
+
+@dataclass(frozen=True)
+class Results:
+    """What a report is drawn from: the experiment's config as plain data at the scale run (real sequences
+    located), its runs, their stored records (failed runs have none) and how many failed, per reason."""
+
+    experiment: dict
+    runs: list[Run]
+    records: pd.DataFrame
+    failures: Counter
+    name: str  # the report's: the experiment's, or ``<experiment>@<label>`` for a user's own data or settings
+    changes: tuple[str, ...] = ()  # what the request changed in the shipped experiment (runner.variant)
+    command: str = ""  # the command line that made these results
+
+    @classmethod
+    def of(cls, cfg: DictConfig, runs: list[Run], store: Store, overrides: tuple[str, ...] = ()) -> "Results":
+        """The stored results of ``runs``; ``overrides``: the request's command-line settings (for the page)."""
+        changes = differences(cfg)
+        command = " ".join(["python -m replication", f"experiment={cfg.experiment.name}", f"scale={cfg.scale}",
+                            *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])
+        return cls(experiment_at_scale(cfg), runs, store.load(runs), store.failures(runs),
+                   report_name(cfg, changes), tuple(changes), command)
+
+    @property
+    def own(self) -> bool:
+        """Whether these are a user's runs (own data, methods or settings): they judge no paper claim."""
+        return bool(self.changes)
+
+    def write_tables(self, out: Path) -> list[str]:
+        """The runs (and, for a task with per-frame data, the frames) as tidy tables in ``out``; their
+        file names."""
+        if self.records.empty:
+            return []
+        write(tidy(self.records, self.runs), out / "runs")
+        per_frame = frames(self.records, self.runs)
+        if per_frame.empty:
+            return ["runs.parquet", "runs.csv"]
+        write(per_frame, out / "frames", csv=False)  # no CSV: up to 10^5 rows at quick scale, 10^6 at paper
+        return ["runs.parquet", "runs.csv", "frames.parquet"]
 
 
 def parameters(run: Run) -> dict:

@@ -12,10 +12,11 @@ list is given once.
 
 from replication.errors import ConfigError
 from replication.paths import resolve
-from replication.scenes.mot import MOT_ROOT
-from replication.scenes.otb import OTB_ROOT, find_otb, otb_names
+from replication.scenes.mot import MOT_ROOT, SHIPPED_MOT_ROOT
+from replication.scenes.otb import OTB_ROOT, SHIPPED_OTB_ROOT, find_otb, otb_names
 
-DEFAULT_ROOTS = {"otb": OTB_ROOT, "mot": MOT_ROOT}
+DEFAULT_ROOTS = {"otb": OTB_ROOT, "mot": MOT_ROOT}  # $REPLICATION_OTB / $REPLICATION_MOT, else the shipped data
+SHIPPED_ROOTS = {"otb": SHIPPED_OTB_ROOT, "mot": SHIPPED_MOT_ROOT}
 
 
 def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] | str | None) -> dict:

@@ -24,7 +24,8 @@ import pandas as pd
 from replication.paths import resolve
 from replication.scenes.factory import SequenceMissing
 
-MOT_ROOT = os.environ.get("REPLICATION_MOT") or "../shared/data/mot"  # data.mot in conf/config.yaml
+SHIPPED_MOT_ROOT = "../shared/data/mot"  # where the project's own MOTChallenge sequences are, beside it
+MOT_ROOT = os.environ.get("REPLICATION_MOT") or SHIPPED_MOT_ROOT  # data.mot in conf/config.yaml
 BOX = ["x", "y", "w", "h"]
 
 

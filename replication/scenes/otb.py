@@ -19,7 +19,8 @@ from PIL import Image, UnidentifiedImageError
 
 from replication.paths import resolve
 
-OTB_ROOT = os.environ.get("REPLICATION_OTB") or "../shared/data/otb"  # data.otb in conf/config.yaml
+SHIPPED_OTB_ROOT = "../shared/data/otb"  # where the project's own OTB sequences are, beside it
+OTB_ROOT = os.environ.get("REPLICATION_OTB") or SHIPPED_OTB_ROOT  # data.otb in conf/config.yaml
 # Sequences whose usual ground-truth file is not groundtruth_rect.txt (see SOURCES.md).
 GROUNDTRUTH_FILES = {"Jogging-1": ("Jogging", "groundtruth_rect.1.txt"), "Jogging-2": ("Jogging", "groundtruth_rect.2.txt")}
 ATTRIBUTES_FILE = Path(__file__).with_name("otb_attributes.yaml")

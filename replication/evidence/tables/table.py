@@ -179,7 +179,8 @@ class TableKind:
         return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec["name"],
                           our_method=row["method"], our_condition="" if row["condition"] == "-" else row["condition"],
                           runs=int(row["runs"]),
-                          paper_number=None if pd.isna(cell["number"]) else float(cell["number"]), estimate=estimate, rating=rating, verdict=verdict)
+                          paper_number=None if pd.isna(cell["number"]) else float(cell["number"]),
+                          estimate=estimate, rating=rating, verdict=verdict)
 
 
 def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):

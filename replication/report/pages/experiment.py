@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import yaml
 import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
@@ -23,22 +24,22 @@ from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
-from replication.run import Run
 from replication.scenes.factory import cached_sequence
-from replication.runner.config import experiment_at_scale
-from replication.runner.results import frames, tidy, write
-from replication.runner.store import Store
+from replication.runner.results import Results
+from replication.runner.variant import SHOWN
 
 
-def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> Path:
-    """Write ``<reports>/<experiment>/`` from the stored records of ``runs``; return the page's path."""
-    experiment = experiment_at_scale(cfg)
-    out = resolve(cfg.reports) / experiment["name"]
+def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
+    """Write ``<reports>/<experiment>/`` from an experiment's stored ``results``; return the page's path."""
+    experiment, runs, records, failures = results.experiment, results.runs, results.records, results.failures
+    out = resolve(cfg.reports) / results.name
     out.mkdir(parents=True, exist_ok=True)
-    records, failures = store.load(runs), store.failures(runs)  # failed runs: counted, in no statistic
     published = load_published(str(resolve(cfg.published_values)))
     spec = experiment.get("report", {})
-    tables, figures, built, files, results, left_out = [], [], {}, [], [], []
+    tables, figures, built, left_out = [], [], {}, []
+    files = results.write_tables(out)
+    results_folders = [f"results/{folder}/" for layout, folder in LAYOUTS.items()  # real OTB runs, for the toolkits
+                       if len(records) and write_results(runs, records, out / "results", layout)]
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -62,18 +63,10 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link,
                             **beside})
-        write(tidy(records, runs), out / "runs")
-        files += ["runs.parquet", "runs.csv"]
-        per_frame = frames(records, runs)
-        if len(per_frame):  # no CSV: up to 10^5 rows at quick scale, 10^6 at paper scale (bis_pf)
-            write(per_frame, out / "frames", csv=False)
-            files.append("frames.parquet")
-        for layout, folder in LAYOUTS.items():  # runs on real OTB sequences, for other toolkits to re-score
-            if write_results(runs, records, out / "results", layout):
-                results.append(f"results/{folder}/")
     compared = tuple(cell for table in built.values() for cell in table.cells)
     matched = {cell.published_index for cell in compared}
-    claims = evaluate(experiment["name"], experiment, records, built, published)
+    # a user's own data or settings judge no paper claim: the claims name the papers' data
+    claims = {} if results.own else evaluate(experiment["name"], experiment, records, built, published)
     changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
@@ -94,7 +87,7 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             scenes=_scenes(experiment, OmegaConf.to_container(cfg.experiment, resolve=True)),
             figures=figures,
             left_out=left_out,
-            results=results,
+            results=results_folders,
             unmatched=html_table(unmatched[["table", "method", "metric", "condition", "value", "unit", "note"]])
             if len(unmatched)
             else None,
@@ -102,16 +95,19 @@ def write_experiment_report(cfg: DictConfig, runs: list[Run], store: Store) -> P
             claims=_claims_shown(claims),
             scale_note=scale_note(cfg.scale, changes),
             provenance=_provenance(records),
-            name=experiment["name"],
+            name=results.name,
+            changes=results.changes[:SHOWN],
+            more_changes=max(len(results.changes) - SHOWN, 0),
             sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),
-            command=f"python -m replication experiment={experiment['name']} scale={cfg.scale}",
-            config=OmegaConf.to_yaml(cfg.experiment),
+            command=results.command,
+            config=yaml.safe_dump(experiment, sort_keys=False),  # as run: at its scale, sequences located
             versions=_versions(),
         )
     )
-    Summary(experiment["name"], experiment.get("title", experiment["name"]), experiment["paper"], cfg.scale,
+    Summary(results.name, experiment.get("title", experiment["name"]), experiment["paper"], cfg.scale,
             len(records), len(runs), dict(failures), compared, claims, tuple(changes),
-            tuple({k: t[k] for k in ("name", "title", "csv", "note")} for t in tables), tuple(figures)).write(out)
+            tuple({k: t[k] for k in ("name", "title", "csv", "note")} for t in tables), tuple(figures),
+            own=results.changes).write(out)
     return page
 
 
@@ -144,9 +140,8 @@ def _prefix(scene: dict) -> str:
         return ""
     short, long = (cached_sequence({**scene, "frames": frames[s]}) for s in ("quick", "paper"))
     same = np.array_equal(short.truth, long.truth[: len(short.truth)])
-    return (f"; the quick scale's {frames['quick']} frames are {'' if same else 'not '}the first "
-            f"{frames['quick']} of the paper scale's {frames['paper']}" + ("" if same else
-                                                                            " (another random walk from the same seed)"))
+    said = f"; the quick scale's {frames['quick']} frames are {'' if same else 'not '}the first {frames['quick']}"
+    return f"{said} of the paper scale's {frames['paper']}" + ("" if same else " (another random walk, same seed)")
 
 
 def _claims_shown(claims: dict[str, dict[str, Result]]) -> list[dict]:

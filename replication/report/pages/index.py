@@ -39,21 +39,22 @@ def _scale_note(summaries: dict[str, Summary]) -> str | None:
             f"Each experiment's page lists what quick changes for it.")
 
 
+def _entry(name: str, summary: Summary) -> dict:
+    """A report's row in the index's tables of experiments."""
+    return {"name": name, "title": summary.title, "paper": summary.paper, "scale": summary.scale,
+            "n_records": summary.n_records, "n_runs": summary.n_runs, "failed": summary.failed,
+            "verdicts": ", ".join(f"{k}: {v}" for k, v in sorted(summary.verdicts.items())) or "-",
+            "ablation": "ablation" in name,  # the studies on top of the papers get their own section
+            "multiverse": bool(summary.multiverse),  # so do the papers' readings
+            "own": summary.own}  # and a user's own data or settings
+
+
 def write_index(reports: Path, published_values: str | Path | None = None) -> Path:
     reports = Path(reports)
     summaries = load_summaries(reports)
-    experiments, missing = [], []
-    for name in experiment_names():
-        if name not in summaries:
-            missing.append(name)
-            continue
-        summary = summaries[name]
-        entry = {"name": name, "title": summary.title, "paper": summary.paper, "scale": summary.scale,
-                 "n_records": summary.n_records, "n_runs": summary.n_runs, "failed": summary.failed,
-                 "verdicts": ", ".join(f"{k}: {v}" for k, v in sorted(summary.verdicts.items())) or "-",
-                 "ablation": "ablation" in name,  # the studies on top of the papers get their own section
-                 "multiverse": bool(summary.multiverse)}  # so do the papers' readings
-        experiments.append(entry)
+    missing = [name for name in experiment_names() if name not in summaries]
+    experiments = [_entry(name, summary) for name, summary in summaries.items()]
+    own = [_entry(name, summary) for name, summary in load_summaries(reports, own=True).items()]
     published = load_published(str(resolve(published_values or default_published_values())))
     papers = load_papers()
     rows = claim_rows(papers, summaries)
@@ -68,6 +69,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             "index.html.j2",
             title=TITLE,
             experiments=experiments,
+            own=own,
             missing=missing,
             cells=cells.to_dict("records"),
             papers=[{"paper": paper, "claims": rows[paper.key], "tally": tally(rows[paper.key]),

@@ -107,7 +107,7 @@ def _headline(robustness: Robustness) -> str | None:
     return deciding.what if deciding and deciding.estimate is not None else None
 
 
-def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse) -> Path:
+def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = ()) -> Path:
     """``<reports>/<paper>_readings/``: the choices, the universes run, each claim's robustness with every
     case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard."""
     out = resolve(cfg.reports) / multiverse.name
@@ -127,7 +127,8 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse) -> Path:
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
         robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
         scale_note=scale_note(cfg.scale), config=OmegaConf.to_yaml(cfg.experiment),
-        command=f"python -m replication experiment={multiverse.name} scale={cfg.scale}"))
+        command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
+                          *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
     figures = ({"name": "readings", "file": "readings.png",
                 "title": "Each claim's deciding number in every universe (95% CI, coloured by verdict)"},)
     Summary(multiverse.name, cfg.experiment.get("title", multiverse.name), multiverse.paper, cfg.scale, n_records,

@@ -42,9 +42,10 @@ def scale_note(scale: str, changes: list[str] | None = None) -> str | None:
     if scale == "paper":
         return None
     listed = "" if changes is None else f" ({'; '.join(changes) or 'for this experiment, nothing'})"
+    runs = INFERENCE.min_runs
     return (f"Quick scale: fewer runs and shorter scenes than the papers'{listed}. Intervals are wider, "
-            f"verdicts from fewer than {INFERENCE.min_runs} runs are 'not testable', and a ranking over sequences cut short is "
-            f"marked not reliable and decides no claim (a full-length ranking can differ). With {INFERENCE.min_runs} paired runs "
-            f"an exact test reaches p = 1/{2 ** INFERENCE.min_runs} at best, and a paired t-test finds an effect of "
-            f"{detectable(1.0, INFERENCE.min_runs):.2g} standard deviations with 80% power: most claims are then inconclusive, "
-            f"which is what {INFERENCE.min_runs} runs can say. Paper scale: {PAPER_COMMAND}.")
+            f"verdicts from fewer than {runs} runs are 'not testable', and a ranking over sequences cut short is "
+            f"marked not reliable and decides no claim (a full-length ranking can differ). With {runs} paired runs "
+            f"an exact test reaches p = 1/{2 ** runs} at best, and a paired t-test finds an effect of "
+            f"{detectable(1.0, runs):.2g} standard deviations with {INFERENCE.power:.0%} power: most claims are "
+            f"then inconclusive, which is what {runs} runs can say. Paper scale: {PAPER_COMMAND}.")
