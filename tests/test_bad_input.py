@@ -242,3 +242,24 @@ def test_every_shipped_experiment_passes_the_preflight(make_cfg, scale):
     for name in experiment_names():
         check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
         preflight(make_cfg(name, f"scale={scale}", "outside_project=true"))
+
+
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_alone(tmp_path):
+    """bis_pf_pets with another MOTChallenge sequence in the PETS scene's place: reported as bis_pf_pets@campus,
+    the bis_pf.pets and bis_pf.cost rows (and every other) of claims.csv byte-identical."""
+    from replication.report.pages.index import write_index
+
+    if not (PROJECT_ROOT / "../shared/data/mot/TUD-Campus").is_dir():
+        pytest.skip("MOT data not beside the project")
+    before = (write_index(tmp_path / "reports").parent / "claims.csv").read_bytes()
+    result, _ = request(tmp_path, "experiment=bis_pf_pets", "scale=quick", "experiment.runs.quick=1",
+                        "experiment.scenes.exp6_pets09.name=TUD-Campus", "experiment.scenes.exp6_pets09.last=20",
+                        "label=campus")
+    assert result.returncode == 0, result.stderr
+    assert "reported as bis_pf_pets@campus" in result.stdout
+    assert (tmp_path / "reports" / "claims.csv").read_bytes() == before
+    page = (tmp_path / "reports" / "bis_pf_pets@campus" / "index.html").read_text()
+    assert "Not the paper&#39;s experiment" in page or "Not the paper's experiment" in page
+    assert 'scenes.exp6_pets09.name: &#34;PETS09-S2L1&#34; -&gt; &#34;TUD-Campus&#34;' in page
+    assert not (tmp_path / "reports" / "bis_pf_pets").exists()
