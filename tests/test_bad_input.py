@@ -263,3 +263,26 @@ def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_a
     assert "Not the paper&#39;s experiment" in page or "Not the paper's experiment" in page
     assert 'scenes.exp6_pets09.name: &#34;PETS09-S2L1&#34; -&gt; &#34;TUD-Campus&#34;' in page
     assert not (tmp_path / "reports" / "bis_pf_pets").exists()
+
+
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+def test_sequences_of_ones_own_run_through_a_mot_experiment_and_its_figures_follow_them(tmp_path):
+    """``data.mot=<folder> sequences=[...]`` with bis_pf_pets: the runs are on the user's MOTChallenge sequence
+    alone (a copy of TUD-Campus under another name), its snapshots and identity timeline drawn for it, and
+    the report is its own."""
+    source = PROJECT_ROOT / "../shared/data/mot/TUD-Campus"
+    if not source.is_dir():
+        pytest.skip("MOT data not beside the project")
+    mine = tmp_path / "mot" / "MyCampus"
+    mine.mkdir(parents=True)
+    (mine / "img1").symlink_to(source.resolve() / "img1")
+    for part in ("seqinfo.ini", "gt", "det"):
+        (shutil.copytree if (source / part).is_dir() else shutil.copy)(source / part, mine / part)
+    result, _ = request(tmp_path, "experiment=bis_pf_pets", "scale=quick", "experiment.runs.quick=1",
+                        f"data.mot={mine.parent}", "sequences=[MyCampus]", "label=mine")
+    assert result.returncode == 0, result.stderr
+    records = list((tmp_path / "experiments" / "bis_pf_pets" / "runs").glob("*.json"))
+    assert records and all("scene=MyCampus" in r.read_text() for r in records)
+    folder = tmp_path / "reports" / "bis_pf_pets@mine"
+    assert (folder / "snapshots.png").stat().st_size > 10_000 and (folder / "identities.png").exists()
+    assert "table1_time needs scene=exp6_pets09" in result.stderr  # the paper's timing table: said up front

@@ -2,9 +2,10 @@
 
 ``data.otb`` and ``data.mot`` (``conf/config.yaml``; ``$REPLICATION_OTB`` / ``$REPLICATION_MOT``)
 are the folders of OTB- and MOTChallenge-layout sequences; a scene's own ``root:`` wins over them.
-``sequences=[A,B]`` (or ``sequences=all``: every sequence in ``data.otb``) replaces the OTB
-sequences of an experiment, each read with the settings of the experiment's first (e.g. ``last:``,
-the frames it reads), and the runs are on them alone.  A sequence named there must exist:
+``sequences=[A,B]`` (or ``sequences=all``: every sequence in ``data.otb``, or ``data.mot`` for a
+MOTChallenge experiment) replaces the real sequences of an experiment, each read with the settings of
+the experiment's first (e.g. ``last:``, the frames it reads), and the runs are on them alone; figures
+and tables that named a replaced scene are drawn for each of them.  A sequence named there must exist:
 a missing one is an error, whereas a missing shipped default is skipped (the data may not be on
 this machine).  An experiment with ``scenes:`` whose model names no scene runs every scene, so the
 list is given once.
@@ -12,7 +13,7 @@ list is given once.
 
 from replication.errors import ConfigError
 from replication.paths import resolve
-from replication.scenes.mot import MOT_ROOT, SHIPPED_MOT_ROOT
+from replication.scenes.mot import MOT_ROOT, SHIPPED_MOT_ROOT, find_mot, mot_names
 from replication.scenes.otb import OTB_ROOT, SHIPPED_OTB_ROOT, find_otb, otb_names
 
 DEFAULT_ROOTS = {"otb": OTB_ROOT, "mot": MOT_ROOT}  # $REPLICATION_OTB / $REPLICATION_MOT, else the shipped data
@@ -21,7 +22,8 @@ SHIPPED_ROOTS = {"otb": SHIPPED_OTB_ROOT, "mot": SHIPPED_MOT_ROOT}
 
 def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] | str | None) -> dict:
     """``experiment`` (plain data at its scale) with its real scenes' roots filled in, the user's
-    ``sequences`` in place of its OTB scenes, and a scene sweep over every scene where none is named."""
+    ``sequences`` in place of its real ones (and in its report's figures and tables), and a scene sweep over
+    every scene where none is named."""
     roots = {kind: (data or {}).get(kind) or default for kind, default in DEFAULT_ROOTS.items()}
     for kind, root in roots.items():
         if (data or {}).get(kind) and not resolve(root).is_dir():
@@ -33,8 +35,11 @@ def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] |
     model = dict(experiment.get("model") or {})
     sweep = dict(model.get("sweep") or {})
     if sequences is not None:
-        scenes = own_sequences(scenes, sequences, roots["otb"])
-        sweep["scene"] = [name for name, spec in scenes.items() if spec.get("kind") == "otb"]
+        shipped = set(scenes)
+        scenes = own_sequences(scenes, sequences, roots)
+        sweep["scene"] = [name for name, spec in scenes.items() if spec.get("kind") in FINDERS]
+        report = follow_sequences(experiment.get("report") or {}, shipped - set(scenes), sweep["scene"])
+        experiment = {**experiment, "report": report}
     elif scenes and model.get("scene") is None and "scene" not in sweep:
         sweep["scene"] = list(scenes)
     if "scene" in sweep:
@@ -44,19 +49,41 @@ def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] |
     return {**experiment, "scenes": scenes, "model": model} if scenes else experiment
 
 
-def own_sequences(scenes: dict, sequences: list[str] | str, root: str) -> dict:
-    """``scenes`` with the user's ``sequences`` under ``root`` added, each read like the experiment's
-    first OTB scene, in place of its OTB scenes (its synthetic ones stay, unswept)."""
-    shipped = [spec for spec in scenes.values() if spec.get("kind") == "otb"]
-    if not shipped:
-        raise ConfigError("sequences= replaces the OTB sequences of an experiment that has some "
-                          "(hspf, ism_pf_otb, fusion_pf_otb, gps_qmcpf_otb, ...)")
-    names = otb_names(root) if sequences == "all" else sequences
+def own_sequences(scenes: dict, sequences: list[str] | str, roots: dict[str, str]) -> dict:
+    """``scenes`` with the user's ``sequences`` in place of its real ones (OTB where it has some, else
+    MOTChallenge), each read like the experiment's first real scene of that kind (its synthetic ones stay,
+    unswept)."""
+    kind = next((k for k in FINDERS if any(spec.get("kind") == k for spec in scenes.values())), None)
+    if kind is None:
+        raise ConfigError("sequences= replaces the real sequences of an experiment that has some (OTB: hspf, "
+                          "ism_pf_otb, fusion_pf_otb, gps_qmcpf_otb; MOTChallenge: bis_pf_pets)")
+    names_of, find = FINDERS[kind]
+    names = names_of(roots[kind]) if sequences == "all" else sequences
     if isinstance(names, str) or not names or not all(isinstance(n, str) for n in names):
-        raise ConfigError(f"sequences must be a list of OTB sequence names or all, got {sequences!r}")
-    _, missing = find_otb(list(names), root)
+        raise ConfigError(f"sequences must be a list of {kind.upper()} sequence names or all, got {sequences!r}")
+    _, missing = find(list(names), roots[kind])
     if missing:
         raise ConfigError(f"sequences: {missing[0].removesuffix(': skipped')}")
+    shipped = [spec for spec in scenes.values() if spec.get("kind") == kind]
     template = {k: v for k, v in shipped[0].items() if k not in ("name", "stand_in")}
-    kept = {name: spec for name, spec in scenes.items() if spec.get("kind") != "otb"}
-    return {**kept, **{name: {**template, "name": name, "root": str(root)} for name in names}}
+    kept = {name: spec for name, spec in scenes.items() if spec.get("kind") != kind}
+    return {**kept, **{name: {**template, "name": name, "root": str(roots[kind])} for name in names}}
+
+
+def follow_sequences(report: dict, replaced: set[str], scenes: list[str]) -> dict:
+    """A report spec whose figures and tables named a replaced scene drawn for the user's ``scenes`` instead:
+    ``conditions: [scene=...]`` for each of them, a one-scene figure's ``scene:`` (a video) for the first;
+    one naming only kept scenes stays as it is."""
+    def moved(spec: dict) -> dict:
+        if spec.get("scene") in replaced:
+            spec = {**spec, "scene": scenes[0]}
+        named = [c for c in spec.get("conditions", []) if c.removeprefix("scene=") in replaced]
+        if not named:
+            return spec
+        return {**spec, "conditions": [f"scene={name}" for name in scenes]}
+
+    return {**report, **{part: [moved(spec) for spec in report.get(part, [])] for part in ("tables", "figures")
+                         if part in report}}
+
+
+FINDERS = {"otb": (otb_names, find_otb), "mot": (mot_names, find_mot)}  # a kind of real sequence: list, find

@@ -114,6 +114,18 @@ def read_seqinfo(path: Path) -> tuple[float, tuple[int, int], int, str, str]:
         raise ValueError(" ".join(message.split())) from None
 
 
+def mot_names(root: str = MOT_ROOT) -> list[str]:
+    """Every sequence under ``root``: its folders holding a ``seqinfo.ini``, by name."""
+    return sorted(p.parent.name for p in resolve(root).glob("*/seqinfo.ini"))
+
+
+def find_mot(names: list[str], root: str = MOT_ROOT) -> tuple[list[str], list[str]]:
+    """Split ``names`` into the sequences present under ``root`` and messages for the absent ones."""
+    present = set(mot_names(root))
+    return ([n for n in names if n in present],
+            [f"MOT sequence {n!r} is not in {resolve(root)}: skipped" for n in names if n not in present])
+
+
 def load_mot(name: str, root: str = MOT_ROOT) -> MotSequence:
     """Sequence ``name`` under ``root``; :class:`SequenceMissing` if it or one of its files is absent."""
     directory = resolve(root) / name
