@@ -17,10 +17,9 @@ import pandas as pd
 
 from replication.condition import label_of, values_of
 from replication.evidence.quantities import quantity
-from replication.evidence.statistics import stratified_mean
-
-from replication.scenes.otb import otb_attributes
 from replication.evidence.settings import INFERENCE
+from replication.evidence.statistics import stratified_mean
+from replication.scenes.otb import otb_attributes
 
 METRICS = ("precision20", "success_auc")  # OTB's two scores
 

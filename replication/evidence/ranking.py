@@ -36,10 +36,9 @@ import pandas as pd
 from replication.evidence.quantities import quantity
 from replication.evidence.comparisons import best_test
 from replication.evidence.inference import holm
-from replication.evidence.statistics import Estimate, paired_difference
-
-from replication.condition import label_of, values_of
 from replication.evidence.settings import INFERENCE
+from replication.evidence.statistics import Estimate, paired_difference
+from replication.condition import label_of, values_of
 
 TIE = 1e-12  # means closer than this (relative to the largest score) are level: summation order, not skill
 

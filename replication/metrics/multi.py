@@ -31,8 +31,7 @@ def identity_free_error(estimates: np.ndarray, truth: np.ndarray) -> float:
     """The error with identities left out: in each frame, the estimates assigned to the truths by minimum
     total distance (Hungarian, :func:`scipy.optimize.linear_sum_assignment`), the mean matched distance
     over frames and targets.  Two estimates that swap balls keep a small error here."""
-    d = _pairwise(estimates, truth)
-    return float(np.mean([d[k][linear_sum_assignment(d[k])].mean() for k in range(len(d))]))
+    return float(assignments(estimates, truth)[1].mean())
 
 
 def ospa(estimates: np.ndarray, truth: np.ndarray, cutoff: float, order: int = 1) -> float:

@@ -37,6 +37,12 @@ def centres(boxes: np.ndarray) -> np.ndarray:
     return boxes[..., :2] + boxes[..., 2:4] / 2.0
 
 
+def outside_image(boxes: np.ndarray, size) -> np.ndarray:
+    """Whether each box's centre lies outside an image of ``size`` (width, height): boxes (..., 4) -> (...)."""
+    points = centres(boxes)
+    return (points < 0).any(axis=-1) | (points[..., 0] >= size[0]) | (points[..., 1] >= size[1])
+
+
 def deviation(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
     """Per-frame (column, row) deviation of the estimated centre from the true one, in px (fusion_pf Fig. 3)."""
     return centres(estimates) - centres(truth)

@@ -159,9 +159,7 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
 def outside_frames(estimates: np.ndarray, size) -> int:
     """How many (frame, target) estimates put the box's centre outside the image (width, height): the
     filter's own state, never clipped, so a tracker that runs off the frame shows it."""
-    centres = tm.centres(estimates)
-    inside = (centres >= 0).all(axis=-1) & (centres[..., 0] < size[0]) & (centres[..., 1] < size[1])
-    return int((~inside).sum())
+    return int(tm.outside_image(estimates, size).sum())
 
 
 def run(run: Run) -> dict:

@@ -11,7 +11,7 @@ from matplotlib.colors import to_rgb
 from replication.evidence.aggregate import scene_of, sequence_seen
 from replication.evidence.attributes import absent, attribute_scores
 from replication.metrics import multi
-from replication.metrics.tracking import centres
+from replication.metrics.tracking import centres, outside_image
 from replication.report.figures.style import (
     NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
 )
@@ -317,11 +317,9 @@ def outside_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Pat
     """Per frame, the share of targets whose estimated centre lies outside the image (the filter's own state,
     never clipped), mean over runs, per method: a tracker that runs off the frame shows it here."""
     sequence, _ = _sequence(experiment, records)
-    width, height = sequence.size
     fig, ax = plt.subplots(figsize=(7, 2.8))
     for method, runs in records.groupby("method", sort=False):
-        points = np.array([centres(np.array(r["box"], dtype=float)) for r in runs["per_frame"]])  # runs, T, M, 2
-        outside = (points < 0).any(axis=-1) | (points[..., 0] >= width) | (points[..., 1] >= height)
+        outside = outside_image(np.array([r["box"] for r in runs["per_frame"]], dtype=float), sequence.size)
         ax.plot(np.arange(outside.shape[1]), outside.mean(axis=(0, 2)), **method_look(method).line(),
                 markevery=max(1, outside.shape[1] // 12), markersize=4, lw=1.2,
                 label=method_label(experiment, method))

@@ -12,12 +12,11 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
-from replication.evidence.claims import Result
+from replication.evidence.claims import Result, evaluate
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
-from replication.evidence.claims import evaluate
 from replication.report.figures import draw
 from replication.evidence.published import cells, load_published
 from replication.report.pages.render import html_table, render
