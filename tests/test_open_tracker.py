@@ -39,8 +39,12 @@ def test_a_track_dies_after_its_unsupported_frames_or_when_it_leaves_the_image()
     deaths = Deleter(frames=3, min_rho=0.7)
     assert deaths.supported(np.array([True, False, False]), np.array([0.1, 0.8, 0.6])).tolist() == [True, True, False]
     boxes = np.array([[10, 10, 20, 40], [10, 10, 20, 40], [95, 10, 20, 40]], float)
-    dead = deaths.dead(np.array([2, 3, 0]), boxes, (100, 100))
-    assert dead.tolist() == [False, True, True]  # 3 frames unsupported; centre x = 105 is outside
+    causes = deaths.causes(np.array([2, 3, 0]), boxes, (100, 100))
+    assert causes["unsupported"].tolist() == [False, True, False]  # 3 frames unsupported
+    assert causes["outside"].tolist() == [False, False, True]  # centre x = 105 is outside
+    assert deaths.dead(np.array([2, 3, 0]), boxes, (100, 100)).tolist() == [False, True, True]
+    assert Deleter(frames=3, min_rho=None).supported(np.array([True, False]), np.array([0.1, 1.0])).tolist() == [
+        True, False]  # detections alone support it
 
 
 def _model(alpha, detection=None):
@@ -78,6 +82,32 @@ def test_importance_weights_make_the_mixture_unbiased_for_the_prior():
     assert (weights @ moved / weights.sum()) == pytest.approx([50.0, 50, 20, 40], abs=0.15)
 
 
+class _Flat:
+    """A colour likelihood that is the same everywhere: what is left of the likelihood is the detection term."""
+
+    def prepare(self, frame):
+        return None
+
+    def log_likelihood(self, boxes, prepared):
+        return np.full(len(boxes), -1.5)
+
+
+def test_the_detection_term_adds_the_detections_gaussian_log_density_to_the_colour_likelihood():
+    model = BoostedBoxModel(np.array([50.0, 50, 20, 40]), _Flat(), step_sd=(4.0, 4.0, 1.0, 2.0),
+                            detection_term=(0.1, 0.1, 0.05, 0.05))
+    particles = np.array([[50.0, 50, 20, 40], [61.0, 47, 23, 41]])
+    assert model.log_likelihood(particles, None, 1).tolist() == [-1.5, -1.5]  # no detection this frame
+    model.detection = np.array([60.0, 52, 22, 38])
+    sd = np.array([2.2, 3.8, 1.1, 1.9])  # 0.1 w, 0.1 h, 0.05 w, 0.05 h of the detection
+    expected = -1.5 + multivariate_normal(model.detection, np.diag(sd**2)).logpdf(particles)
+    assert np.allclose(model.log_likelihood(particles, None, 1), expected, rtol=1e-12)
+    untermed = BoostedBoxModel(np.array([50.0, 50, 20, 40]), _Flat(), step_sd=(4.0, 4.0, 1.0, 2.0))
+    untermed.detection = model.detection
+    assert untermed.log_likelihood(particles, None, 1).tolist() == [-1.5, -1.5]  # Okuma et al.: proposal only
+    with pytest.raises(ValueError, match="detection_term"):
+        BoostedBoxModel(np.array([50.0, 50, 20, 40]), None, detection_term=(0.1, 0.0, 0.1, 0.1))
+
+
 @dataclass
 class _Square:
     """A MOT-like sequence: one red square on grey, frames 3-10 detected, gone from frame 11."""
@@ -110,6 +140,31 @@ def test_a_target_is_born_from_persistent_detections_and_dies_after_its_absence(
     assert all(out[f] == [1] for f in range(5, 11))
     assert all(out[f] == [] for f in range(11, 17))  # gone: unsupported from 11, dead at 13, never output again
     assert tracker.born == 1
+    # born at 5; live frames 6..13 (8), detected 6..10 (5), the grey background never supports it (rho < 0.7),
+    # output on 5..10 (6), dead at 13 on its third unsupported frame
+    assert tracker.counts == {"births": 1, "track_frames": 8, "detected_frames": 5, "colour_frames": 0,
+                              "shown_frames": 6, "died_unsupported": 1, "died_outside": 0}
+
+
+def test_output_detected_shows_a_track_only_in_the_frames_a_detection_is_associated_with_it():
+    class Gappy(_Square):
+        detections = _Square.detections[_Square.detections["frame"] != 8]  # a missed detection at frame 8
+
+        def image(self, frame):
+            return _Square().image(min(frame, 10))  # the square stays: its colour supports it at frame 8
+
+    cache: dict = {}
+
+    def new_model(image, box):
+        histogram = ColourHistogram(bins=(8, 8, 4), kernel="epanechnikov", grid=(8, 8))
+        return BoostedBoxModel(box, ColourLikelihood.from_frame(image, box, histogram, 0.1), cache=cache,
+                               step_sd=(2.0, 2.0, 0.5, 0.5), alpha=0.5)
+
+    for output, shown in (("supported", True), ("detected", False)):
+        tracker = ParticleTracker(FILTERS["mipf"](n_particles=200), new_model, Initiator(frames=2),
+                                  Deleter(frames=3, min_rho=0.7), output=output)
+        out = {frame: ids.tolist() for frame, ids, _ in tracker.track(Gappy(), range(1, 12), np.random.default_rng(0))}
+        assert out[7] == out[9] == [1] and (out[8] == [1]) is shown
 
 
 def test_the_matched_centre_error_averages_the_centre_distances_of_the_clear_mot_matches():

@@ -16,12 +16,13 @@ own time (decoding the frames excluded, as bis_pf's timings exclude it).
 Per frame, a particle tracker: associates the detections with the tracks' boxes of the
 previous frame; steps the joint filter (each target's proposal fed its detection); marks
 each track supported or not and ends the dead ones; outputs the tracks alive (by
-default only in frames where they are supported: ``output: supported``; ``alive``
-outputs every frame of a track's life); then starts the tracks born this frame, each
+``output: supported``, in frames where they are supported; ``detected``, where a detection is
+associated with them, as SORT outputs; ``alive``, every frame of a track's life); then starts the tracks born this frame, each
 with its colour reference from its first detection's box in this frame.
 """
 
 import time
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import partial
@@ -36,7 +37,13 @@ from replication.metrics.mot import BOX
 from replication.metrics.tracking import centres
 from replication.models.box import BoxModel
 
-OUTPUTS = ("supported", "alive")
+# Which of a live track's frames are output, from whether a detection is associated with it this frame and
+# whether it is supported (a detection or its colour, :class:`Deleter`).
+OUTPUTS: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
+    "detected": lambda detected, supported: detected,
+    "supported": lambda detected, supported: supported,
+    "alive": lambda detected, supported: np.ones_like(supported),
+}
 Frame = tuple[int, np.ndarray, np.ndarray]  # MOT frame number, ids (K,), boxes (K, 4)
 
 
@@ -45,12 +52,20 @@ def _centred(boxes: np.ndarray) -> np.ndarray:
     return np.column_stack([centres(boxes), boxes[:, 2:4]])
 
 
+EVENTS = ("births", "track_frames", "detected_frames", "colour_frames", "shown_frames", "died_unsupported",
+          "died_outside")
+
+
 @dataclass
 class ParticleTracker:
     """A joint filter over the targets alive, with births, deaths and the detection-fused proposal.
 
     ``new_model(image, box)`` makes a target's model from its first detection (cx, cy, w, h)
-    in ``image``.
+    in ``image``.  ``counts`` adds up, over the frames tracked, the :data:`EVENTS`: tracks born, the
+    frames of live tracks (a track's frame after its birth frame), those with an associated detection
+    (each such frame's proposal draws ``alpha`` of its particles from the detection), those supported by
+    the colour alone, those output (birth frames included), and the deaths by cause (lost support; the
+    centre leaving the image).
     """
 
     method: JointFilter
@@ -62,10 +77,11 @@ class ParticleTracker:
     output: str = "supported"
     seconds: float = field(default=0.0, init=False)
     born: int = field(default=0, init=False)  # tracks started
+    counts: Counter = field(default_factory=Counter, init=False)  # where the tracks' frames went (EVENTS)
 
     def __post_init__(self):
         if self.output not in OUTPUTS:
-            raise ValueError(f"unknown output {self.output!r}; choose one of {OUTPUTS}")
+            raise ValueError(f"unknown output {self.output!r}; choose one of {sorted(OUTPUTS)}")
 
     def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
         detections = detection_boxes(sequence.detections, self.min_score)
@@ -83,10 +99,16 @@ class ParticleTracker:
                 means = np.array([records.means[-1][:4] for records in state.records])
                 boxes = BoxModel.boxes(means)
                 rho = np.array([model.similarity(mean[None], image, state.t)[0] for model, mean in zip(state.models, means)])
-                supported = self.deaths.supported(assigned >= 0, rho)
+                detected = assigned >= 0
+                supported = self.deaths.supported(detected, rho)
                 unsupported = np.where(supported, 0, unsupported + 1)
-                dead = self.deaths.dead(unsupported, boxes, sequence.size)
-                shown = ~dead & (supported | (self.output == "alive"))
+                causes = self.deaths.causes(unsupported, boxes, sequence.size)
+                dead = causes["unsupported"] | causes["outside"]
+                shown = ~dead & OUTPUTS[self.output](detected, supported)
+                self.counts.update({"track_frames": len(ids), "detected_frames": int(detected.sum()),
+                                    "colour_frames": int((supported & ~detected).sum()), "shown_frames": int(shown.sum()),
+                                    "died_unsupported": int((dead & causes["unsupported"]).sum()),
+                                    "died_outside": int((dead & ~causes["unsupported"]).sum())})
                 out_ids, out_boxes = ids[shown], boxes[shown]
                 for index in np.flatnonzero(dead)[::-1]:
                     self.method.remove(state, int(index))
@@ -98,6 +120,7 @@ class ParticleTracker:
             for box in born:
                 self.method.add(state, self.new_model(image, _centred(box[None])[0]))
             new_ids = np.arange(self.born + 1, self.born + len(born) + 1)
+            self.counts.update({"births": len(born), "shown_frames": len(born)})
             self.born += len(born)
             ids, boxes = np.concatenate([ids, new_ids]), np.vstack([boxes, born])
             unsupported = np.concatenate([unsupported, np.zeros(len(born), int)])
@@ -111,6 +134,7 @@ class DetectionTracker:
 
     link: Callable[[pd.DataFrame], pd.DataFrame]
     seconds: float = field(default=0.0, init=False)
+    counts: Counter = field(default_factory=Counter, init=False)  # no particles: no EVENTS
 
     def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
         frames = list(frames)

@@ -13,7 +13,7 @@ number is a config value and our choice (``conf/experiment/bis_pf_pets.yaml`` sa
   track, born at its last detection.
 * :class:`Deleter`: a track is supported in a frame by an associated detection or by its
   own appearance (the colour similarity rho of its estimate to its reference at least
-  ``min_rho``); it dies after ``frames`` consecutive frames without support, or at once
+  ``min_rho``; ``None``: by detections alone, as tracking-by-detection does); it dies after ``frames`` consecutive frames without support, or at once
   when its centre leaves the image.
 """
 
@@ -64,18 +64,23 @@ class Deleter:
     """Deaths after ``frames`` consecutive frames without support, or on leaving the image."""
 
     frames: int = 20
-    min_rho: float = 0.7
+    min_rho: float | None = 0.7  # None: only detections support a track
 
     def __post_init__(self):
-        if self.frames < 1 or not 0 <= self.min_rho <= 1:
-            raise ValueError(f"deaths need frames >= 1 and min_rho in [0, 1]; got {self}")
+        if self.frames < 1 or not (self.min_rho is None or 0 <= self.min_rho <= 1):
+            raise ValueError(f"deaths need frames >= 1 and min_rho in [0, 1] or None; got {self}")
 
     def supported(self, detected: np.ndarray, rho: np.ndarray) -> np.ndarray:
         """Whether each track is supported this frame: a detection, or its appearance."""
-        return detected | (rho >= self.min_rho)
+        return detected if self.min_rho is None else detected | (rho >= self.min_rho)
 
-    def dead(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-        """Which tracks die: ``unsupported`` frames in a row reach ``frames``, or the box's centre is outside the image."""
+    def causes(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> dict[str, np.ndarray]:
+        """Why each track would die: ``unsupported`` frames in a row reach ``frames``; its box's centre is
+        outside the image."""
         centre = centres(boxes)
         outside = (centre < 0).any(axis=1) | (centre[:, 0] >= size[0]) | (centre[:, 1] >= size[1])
-        return (unsupported >= self.frames) | outside
+        return {"unsupported": unsupported >= self.frames, "outside": outside}
+
+    def dead(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+        """Which tracks die, for either cause of :meth:`causes`."""
+        return np.logical_or.reduce(list(self.causes(unsupported, boxes, size).values()))

@@ -11,6 +11,11 @@ after resampling.  The motion prior is the random walk (a Gaussian step of ``ste
 coordinate), so both densities are exact Gaussians; the clamp of sizes at ``min_size`` px is
 left out of them (pedestrians are tens of pixels).  q_det's standard deviations are
 ``detection_sd`` times the detection's (w, h, w, h): not stated in the sources, our choice.
+
+The detections may also enter the likelihood (``detection_term``): p(y_t | x_t) is then the
+colour likelihood times a Gaussian of the associated detection around the state, the
+detection term of Breitenstein et al.'s tracking-by-detection particle filter (TPAMI 2011).
+Okuma et al. use the detections in the proposal only (``detection_term: None``).
 """
 
 from dataclasses import dataclass
@@ -27,6 +32,7 @@ class BoostedBoxModel(BoxModel):
 
     alpha: float = 0.5  # the detections' share of the proposal when there is one
     detection_sd: tuple[float, float, float, float] = (0.1, 0.1, 0.05, 0.05)  # of the detection's (w, h, w, h)
+    detection_term: float | tuple[float, float, float, float] | None = None  # of the detection's (w, h, w, h)
     detection: np.ndarray | None = None  # the detection associated with the target this frame, set by the tracker
 
     def __post_init__(self):
@@ -38,6 +44,11 @@ class BoostedBoxModel(BoxModel):
         self.detection_sd = np.asarray(self.detection_sd, dtype=float)
         if (self.step_sd <= 0).any() or (self.detection_sd <= 0).any():
             raise ValueError("step_sd and detection_sd must be positive for the mixture's densities")
+        if self.detection_term is not None:
+            term = np.asarray(self.detection_term, dtype=float)
+            if term.shape not in ((), (4,)) or (term <= 0).any():
+                raise ValueError(f"detection_term must be one or 4 positive shares of (w, h, w, h), got {term}")
+            self.detection_term = np.broadcast_to(term, (4,)).copy()
 
     def propose(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | float]:
         """Each particle comes from q_det with probability alpha, else from the motion prior; returns the
@@ -53,3 +64,13 @@ class BoostedBoxModel(BoxModel):
         with np.errstate(divide="ignore"):
             log_q = np.logaddexp(np.log(self.alpha) + log_detection, np.log1p(-self.alpha) + log_prior)
         return moved, log_prior - log_q
+
+    def log_likelihood(self, particles: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
+        """The colour log-likelihood, plus, with ``detection_term`` and a detection this frame, the detection's
+        Gaussian log-density around each particle (Breitenstein et al., TPAMI 2011, eq 8's detection term
+        beta I(tr) p_N(p - d*), its sd ``detection_term`` times the detection's (w, h, w, h))."""
+        colour = super().log_likelihood(particles, frame, t)
+        if self.detection_term is None or self.detection is None:
+            return colour
+        sd = self.detection_term * self.detection[[2, 3, 2, 3]]
+        return colour + norm.logpdf(particles[:, :4], self.detection, sd).sum(axis=1)

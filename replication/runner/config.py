@@ -4,7 +4,8 @@ A value written ``{paper: a, quick: b}`` anywhere in the model, scenes or
 methods takes the entry of the current scale (e.g. a scene's frame count).
 The ``sweep:`` block of ``model`` or of a method lists the values a parameter
 takes (``sweep: {n_particles: [500, 200, 100]}``): the runs are the product
-method x swept values x repetition.  Everything else is a parameter, lists
+method x swept values x repetition.  A model sweep may name a key inside a block
+by its path (``sweep: {deaths.frames: [5, 10]}`` sets ``model.deaths.frames``).  Everything else is a parameter, lists
 included (a velocity clamp, histogram bins).  A method's ``only:`` block
 (``only: {scene: [a]}``) keeps it to the conditions with those values; its
 ``observation:`` block overrides keys of ``model.observation`` (fusion_pf's two
@@ -37,6 +38,19 @@ def _sweeps(params: dict[str, Any], on_model: bool, where: str) -> list[tuple[bo
         if not isinstance(values, list) or not values:
             raise ConfigError(f"{where}.sweep.{name} must be a non-empty list of values, got {values!r}")
     return [(on_model, name, list(values)) for name, values in sweep.items()]
+
+
+def _set(params: dict[str, Any], name: str, value: Any) -> None:
+    """``params[name] = value``, a dotted ``name`` (``deaths.frames``) setting a key inside a block, which is
+    copied first so the experiment's own block is left as it is."""
+    *blocks, key = name.split(".")
+    for block in blocks:
+        inner = params.get(block)
+        if inner is not None and not isinstance(inner, dict):
+            raise ConfigError(f"sweep {name}: {block} is {inner!r}, not a block of keys")
+        params[block] = dict(inner or {})
+        params = params[block]
+    params[key] = value
 
 
 def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
@@ -97,7 +111,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
             if observation:
                 run_model["observation"] = {**model.get("observation", {}), **observation}
             for (on_model, name, _), value in zip(sweeps, values):
-                (run_model if on_model else run_params)[name] = value
+                _set(run_model if on_model else run_params, name, value)
             condition = Condition.of((name, value) for (_, name, _), value in zip(sweeps, values))
             data_condition = Condition.of((name, value) for (on_model, name, _), value in zip(sweeps, values)
                                           if on_model)

@@ -12,7 +12,10 @@ The record holds the MOT metrics of its track table against the ground truth of 
 frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.metrics.mot`;
 HOTA by TrackEval: :mod:`replication.metrics.hota`),
 bis_pf's error (the distance from a person's box centre to the centre of the track matched
-to it, in px, averaged over every match), the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
+to it, in px, averaged over every match), tracks started per person, where a particle tracker's
+frames went (the share of its live tracks' frames with an associated detection, and so the share
+of its particles drawn from the detections, ``alpha`` times that; the share kept alive by the colour
+alone; deaths by lost support and by leaving the image), the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
 frame, id, x, y, w, h) for the pictures.
 """
 
@@ -35,7 +38,7 @@ from replication.vision.colour import ColourLikelihood
 from replication.vision.histogram import ColourHistogram
 
 SCENE_KEYS = {"kind", "name", "root", "first", "last", "stand_in"}
-MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal", "min_iou"}
+MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal", "detection_term", "min_iou"}
 TRACK_COLUMNS = ["frame", "id", *BOX]  # a row of the record's ``tracks``
 
 
@@ -74,7 +77,8 @@ def _model_builder(run_model: dict, rng: np.random.Generator):
     def new_model(image: np.ndarray, box: np.ndarray) -> BoostedBoxModel:
         histogram = ColourHistogram(**histogram_args(observation, box[2:4], rng))
         likelihood = ColourLikelihood.from_frame(image, box, histogram, observation.get("sigma", 0.1))
-        return BoostedBoxModel(box, likelihood, cache=cache, **run_model.get("motion", {}), **run_model.get("proposal", {}))
+        return BoostedBoxModel(box, likelihood, cache=cache, detection_term=run_model.get("detection_term"),
+                               **run_model.get("motion", {}), **run_model.get("proposal", {}))
 
     return new_model
 
@@ -88,7 +92,8 @@ def check(model: dict, method: dict) -> None:
         raise ValueError(f"unknown keys {sorted(unknown)}")
     frames_of(spec, sequence_of(spec["name"], spec.get("root", MOT_ROOT)))
     ColourHistogram(**histogram_args(model.get("observation", {}), (8, 8), np.random.default_rng(0)))
-    BoostedBoxModel(np.ones(4), None, **model.get("motion", {}), **model.get("proposal", {}))
+    BoostedBoxModel(np.ones(4), None, detection_term=model.get("detection_term"), **model.get("motion", {}),
+                    **model.get("proposal", {}))
     method_object = build_filter("check", method)
     _tracker(model, method_object, None)
 
@@ -113,6 +118,9 @@ def run(run: Run) -> dict:
         **hota(truth, kept, min_iou=min_iou),
         "mean_error_per_target": matched_centre_error(truth, kept, clear_mot_matches(truth, kept, min_iou=min_iou)),
     }
+    counts, people = tracker.counts, int(truth["id"].nunique())
+    live = counts["track_frames"]
+    detected_share = counts["detected_frames"] / live if live else float("nan")
     return {
         "sequence": sequence.name,
         "first_frame": frames.start,
@@ -120,6 +128,14 @@ def run(run: Run) -> dict:
         "frames": len(frames),
         **scores,
         "tracks_started": int(tracks["id"].nunique()),
+        "people": people,
+        "tracks_per_person": tracks["id"].nunique() / people if people else float("nan"),
+        # where a particle tracker's frames went (ParticleTracker.counts; NaN for the detection references)
+        "detected_share": detected_share,
+        "proposal_detection_share": run.model.get("proposal", {}).get("alpha", 0.5) * detected_share,
+        "colour_share": counts["colour_frames"] / live if live else float("nan"),
+        "deaths_unsupported": counts["died_unsupported"] if live else float("nan"),
+        "deaths_outside": counts["died_outside"] if live else float("nan"),
         "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),

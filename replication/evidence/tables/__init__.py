@@ -1,7 +1,7 @@
 """Report tables, one module per kind; importing the package registers every kind."""
 
 from replication.evidence.tables import (  # noqa: F401  (each registers its kind)
-    attributes, comparison, discrepancy, improvement, modes, ranking, rating, summary,
+    attributes, comparison, discrepancy, improvement, modes, ranking, rating, summary, tuning,
 )
 from replication.evidence.tables.table import KEYS, CellResult, Table, TableKind, match, pair
 

@@ -21,6 +21,7 @@ from replication.report.figures import draw
 from replication.evidence.published import cells, load_published
 from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
+from replication.report.pages.sequences import write_sequence_pages
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
 from replication.scenes.factory import cached_sequence
@@ -62,6 +63,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
             beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
             figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link,
                             **beside})
+    sequences = write_sequence_pages(records, experiment, out) if len(records) else []
     compared = tuple(cell for table in built.values() for cell in table.cells)
     matched = {cell.published_index for cell in compared}
     # a user's own data or settings judge no paper claim: the claims name the papers' data
@@ -98,6 +100,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
             changes=results.changes[:SHOWN],
             more_changes=max(len(results.changes) - SHOWN, 0),
             sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),
+            sequences=sequences,
             command=results.command,
             config=yaml.safe_dump(experiment, sort_keys=False),  # as run: at its scale, sequences located
             versions=_versions(),
