@@ -13,10 +13,8 @@ frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.m
 HOTA by TrackEval: :mod:`replication.metrics.hota`),
 bis_pf's error (the distance from a person's box centre to the centre of the track matched
 to it, in px, averaged over every match), tracks started per person, where a particle tracker's
-frames went (the share of its live tracks' frames with an associated detection, and so the share
-of its particles drawn from the detections, ``alpha`` times that; the share kept alive by the colour
-alone; deaths by lost support and by leaving the image), the time per frame (frame decoding excluded) and the track table itself (``tracks``: rows
-frame, id, x, y, w, h) for the pictures.
+frames went (:func:`breakdown`), the time per frame (frame decoding excluded) and the track table
+itself (``tracks``: rows frame, id, x, y, w, h) for the pictures.
 """
 
 from functools import lru_cache
@@ -38,7 +36,8 @@ from replication.vision.colour import ColourLikelihood
 from replication.vision.histogram import ColourHistogram
 
 SCENE_KEYS = {"kind", "name", "root", "first", "last", "stand_in"}
-MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal", "detection_term", "min_iou"}
+MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal",
+              "detection_term", "min_iou"}
 TRACK_COLUMNS = ["frame", "id", *BOX]  # a row of the record's ``tracks``
 
 
@@ -98,6 +97,20 @@ def check(model: dict, method: dict) -> None:
     _tracker(model, method_object, None)
 
 
+def breakdown(counts: dict, alpha: float) -> dict:
+    """Where a particle tracker's frames went (:class:`ParticleTracker`'s ``counts``): the share of its live
+    tracks' frames with an associated detection, ``alpha`` times that (the share of its particles drawn
+    from the detections), the share kept alive by the colour alone, its deaths by cause.  None without a
+    live track's frame (a detection reference, or no track born)."""
+    live = counts.get("track_frames", 0)
+    if not live:
+        return {}
+    detected = counts["detected_frames"] / live
+    return {"detected_share": detected, "proposal_detection_share": alpha * detected,
+            "colour_share": counts["colour_frames"] / live, "deaths_unsupported": counts["died_unsupported"],
+            "deaths_outside": counts["died_outside"]}
+
+
 def run(run: Run) -> dict:
     spec = run.model["scene_spec"]
     sequence = sequence_of(spec["name"], spec.get("root", MOT_ROOT))
@@ -118,9 +131,7 @@ def run(run: Run) -> dict:
         **hota(truth, kept, min_iou=min_iou),
         "mean_error_per_target": matched_centre_error(truth, kept, clear_mot_matches(truth, kept, min_iou=min_iou)),
     }
-    counts, people = tracker.counts, int(truth["id"].nunique())
-    live = counts["track_frames"]
-    detected_share = counts["detected_frames"] / live if live else float("nan")
+    people = int(truth["id"].nunique())
     return {
         "sequence": sequence.name,
         "first_frame": frames.start,
@@ -130,12 +141,7 @@ def run(run: Run) -> dict:
         "tracks_started": int(tracks["id"].nunique()),
         "people": people,
         "tracks_per_person": tracks["id"].nunique() / people if people else float("nan"),
-        # where a particle tracker's frames went (ParticleTracker.counts; NaN for the detection references)
-        "detected_share": detected_share,
-        "proposal_detection_share": run.model.get("proposal", {}).get("alpha", 0.5) * detected_share,
-        "colour_share": counts["colour_frames"] / live if live else float("nan"),
-        "deaths_unsupported": counts["died_unsupported"] if live else float("nan"),
-        "deaths_outside": counts["died_outside"] if live else float("nan"),
+        **breakdown(tracker.counts, run.model.get("proposal", {}).get("alpha", 0.5)),
         "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),
