@@ -285,4 +285,9 @@ def test_sequences_of_ones_own_run_through_a_mot_experiment_and_its_figures_foll
     assert records and all("scene=MyCampus" in r.read_text() for r in records)
     folder = tmp_path / "reports" / "bis_pf_pets@mine"
     assert (folder / "snapshots.png").stat().st_size > 10_000 and (folder / "identities.png").exists()
+    sequence_page = (folder / "sequences" / "MyCampus.html").read_text()  # a page of its own, its figures on it
+    assert 'href="sequences/MyCampus.html"' in (folder / "index.html").read_text()
+    for figure in ("snapshots", "identities", "video"):
+        assert f'src="MyCampus/{figure}.png"' in sequence_page
+        assert (folder / "sequences" / "MyCampus" / f"{figure}.png").stat().st_size > 5_000
     assert "table1_time needs scene=exp6_pets09" in result.stderr  # the paper's timing table: said up front

@@ -123,3 +123,16 @@ def test_the_three_errors_of_two_balls_that_swap():
     passing = truth.copy()
     passing[3:6, 1, 0] = 10.0  # ball 2 comes within 20 px for frames 3-5, once
     assert multi.close_encounters(passing, 20.0) == 1 and multi.close_encounters(truth, 20.0) == 0
+
+
+def test_detection_overlap_is_one_for_the_detections_themselves_and_the_mean_best_iou_otherwise():
+    from replication.metrics.mot import detection_overlap
+
+    detections = pd.DataFrame([(1, 0, 0, 10, 10, 1.0), (1, 50, 0, 10, 10, 1.0), (2, 0, 0, 10, 10, 1.0)],
+                              columns=["frame", "x", "y", "w", "h", "score"])
+    own = detections.assign(id=[1, 2, 1])[["frame", "id", "x", "y", "w", "h"]]
+    assert detection_overlap(own, detections) == pytest.approx(1.0)
+    shifted = pd.DataFrame([(1, 1, 5, 0, 10, 10), (3, 1, 0, 0, 10, 10)], columns=["frame", "id", "x", "y", "w", "h"])
+    # frame 1: IoU 50 / 150 with the first detection; frame 3 has none: 0
+    assert detection_overlap(shifted, detections) == pytest.approx((50 / 150 + 0.0) / 2)
+    assert np.isnan(detection_overlap(shifted.iloc[:0], detections))

@@ -248,3 +248,23 @@ def test_a_summary_table_is_written_as_numbers_and_read_back_to_the_same_page():
     assert written.loc[0, "mota"] == pytest.approx(np.mean([0.5, 0.6, 0.55, 0.52, 0.58, 0.61]))
     back = Table.read(pd.read_csv(io.StringIO(written.to_csv(index=False))))
     assert back.shown().equals(table.shown())
+
+
+def test_a_tuning_table_picks_the_best_mean_objective_among_the_settings_that_meet_the_constraint():
+    """The rule of bis_pf_pets_tuning, by hand: 'a' has the best MOTA but starts too many tracks per person;
+    'b' is the best of those below 1.5; 'c' is worse; rows come best MOTA first."""
+    from replication.evidence.tables import TableKind
+
+    rows = [(c, m, t) for c, ms, ts in (("a", [0.6, 0.62, 0.61], [2.0, 2.1, 1.9]), ("b", [0.5, 0.52, 0.49], [1.2, 1.3, 1.1]),
+                                         ("c", [0.3, 0.35, 0.31], [1.0, 1.0, 1.2])) for m, t in zip(ms, ts)]
+    records = pd.DataFrame([{"method": "MIPF", "condition": c, "mota": m, "tracks_per_person": t} for c, m, t in rows])
+    spec = {"name": "tuning", "kind": "tuning", "objective": "mota",
+            "constraint": {"metric": "tracks_per_person", "below": 1.5}}
+    table = TableKind.of(spec, {"methods": {}}, pd.DataFrame()).build(records)
+    assert table.frame["condition"].tolist() == ["a", "b", "c"]
+    assert table.frame["picked"].tolist() == ["", "picked", ""]
+    assert table.frame["tracks_per_person < 1.5"].tolist() == ["no", "yes", "yes"]
+    assert table.note.endswith(": b.")
+    strict = {**spec, "constraint": {"metric": "tracks_per_person", "below": 1.0}}
+    none = TableKind.of(strict, {"methods": {}}, pd.DataFrame()).build(records)
+    assert none.frame["picked"].tolist() == ["", "", ""] and none.note.startswith("No setting meets the rule")

@@ -14,7 +14,9 @@ import numpy as np
 import pandas as pd
 import pytest
 from conftest import PROJECT_ROOT, SMALL
+from omegaconf import open_dict
 
+from replication.errors import ConfigError
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.provenance import code_digest
@@ -109,6 +111,19 @@ def test_model_sweeps_share_data_per_condition(make_cfg):
     assert a.rng("data").random() == b.rng("data").random()  # common random numbers for the data
     assert a.rng("filter").random() != b.rng("filter").random()
     assert first["PFT=10;N=100"].rng("data").random() != a.rng("data").random()
+
+
+def test_a_model_sweep_may_set_a_key_inside_a_block_and_leaves_the_block_of_the_others_alone(make_cfg):
+    runs = expand(make_cfg("bis_pf_pets_tuning", "scale=quick", "experiment.runs.quick=1"))
+    frames = {(r.condition.get("births.frames"), r.model["births"]["frames"]) for r in runs}
+    assert frames == {(2, 2), (3, 3)}  # each run's births.frames is its condition's
+    assert all(r.model["births"]["min_iou"] == 0.3 for r in runs)  # the rest of the block as configured
+    assert all(r.model["deaths"]["min_rho"] is None and r.model["deaths"]["frames"] == 5 for r in runs)
+    cfg = make_cfg("bis_pf_pets_tuning", "scale=quick")
+    with open_dict(cfg):
+        cfg.experiment.model.sweep["proposal.alpha.x"] = [1]
+    with pytest.raises(ConfigError, match="sweep proposal.alpha.x: alpha is 0.5, not a block of keys"):
+        expand(cfg)
 
 
 def test_seed_is_a_function_of_identity_only():

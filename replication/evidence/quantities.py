@@ -83,6 +83,7 @@ QUANTITIES = {
     "colour_share": Quantity("bounded", 0.0, 1.0, label="share of live tracks' frames kept by colour alone"),
     "deaths_unsupported": Quantity("positive", label="deaths on lost support"),
     "deaths_outside": Quantity("positive", label="deaths on leaving the image"),
+    "detection_iou": Quantity("bounded", 0.0, 1.0, label="mean IoU of an output box with its nearest detection"),
     "failed": replace(_BINARY, label="runs failed"),
     "ms_per_frame": Quantity("timing", label="time per frame (ms)"),
     "ms_per_step": Quantity("timing", label="time per step (ms)"),

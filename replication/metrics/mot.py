@@ -119,3 +119,15 @@ def matched_centre_error(truth: pd.DataFrame, hypotheses: pd.DataFrame, matches:
     true = matches.merge(truth, left_on=["frame", "truth_id"], right_on=keys, how="left")
     found = matches.merge(hypotheses, left_on=["frame", "hypothesis_id"], right_on=keys, how="left")
     return float(centre_error(found[BOX].to_numpy(), true[BOX].to_numpy()).mean())
+
+
+def detection_overlap(hypotheses: pd.DataFrame, detections: pd.DataFrame) -> float:
+    """The mean, over the hypothesis boxes, of each one's highest IoU with a detection of its frame (0 in a
+    frame without one): 1 for a tracker that outputs the detections themselves, lower the more its boxes
+    are its own.  NaN without a hypothesis."""
+    if hypotheses.empty:
+        return float("nan")
+    found = _by_frame(detections)
+    best = [iou_matrix(rows[BOX].to_numpy(), found[frame][BOX].to_numpy()).max(axis=1) if frame in found
+            else np.zeros(len(rows)) for frame, rows in _by_frame(hypotheses).items()]
+    return float(np.concatenate(best).mean())

@@ -13,8 +13,10 @@ frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.m
 HOTA by TrackEval: :mod:`replication.metrics.hota`),
 bis_pf's error (the distance from a person's box centre to the centre of the track matched
 to it, in px, averaged over every match), tracks started per person, where a particle tracker's
-frames went (:func:`breakdown`), the time per frame (frame decoding excluded) and the track table
-itself (``tracks``: rows frame, id, x, y, w, h) for the pictures.
+frames went (:func:`breakdown`), how close its boxes are to the detections it was given (the mean
+IoU of each output box with its frame's nearest detection: 1 for the detections themselves), the
+time per frame (frame decoding excluded) and the track table itself (``tracks``: rows frame, id,
+x, y, w, h) for the pictures.
 """
 
 from functools import lru_cache
@@ -27,7 +29,9 @@ from replication.filters.joint import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator
 from replication.metrics.hota import hota
-from replication.metrics.mot import BOX, clear_mot_matches, drop_ignored, matched_centre_error, mot_metrics
+from replication.metrics.mot import (
+    BOX, clear_mot_matches, detection_overlap, drop_ignored, matched_centre_error, mot_metrics,
+)
 from replication.models.boosted import BoostedBoxModel
 from replication.run import Run
 from replication.scenes.mot import MOT_ROOT, load_mot
@@ -132,6 +136,8 @@ def run(run: Run) -> dict:
         "mean_error_per_target": matched_centre_error(truth, kept, clear_mot_matches(truth, kept, min_iou=min_iou)),
     }
     people = int(truth["id"].nunique())
+    given = sequence.detections
+    used = given[given["frame"].isin(frames) & (given["score"] >= run.model.get("association", {}).get("min_score", -np.inf))]
     return {
         "sequence": sequence.name,
         "first_frame": frames.start,
@@ -142,6 +148,7 @@ def run(run: Run) -> dict:
         "people": people,
         "tracks_per_person": tracks["id"].nunique() / people if people else float("nan"),
         **breakdown(tracker.counts, run.model.get("proposal", {}).get("alpha", 0.5)),
+        **({"detection_iou": detection_overlap(tracks, used)} if len(tracks) else {}),
         "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),
