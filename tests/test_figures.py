@@ -227,3 +227,25 @@ def test_the_encounter_strip_marks_a_swap_where_the_per_identity_error_jumps(dra
     assert per_identity.get_ydata()[15] < 20 < per_identity.get_ydata()[20]
     figures.draw(records, {"name": "o", "kind": "outside_curve"}, experiment, tmp_path / "o.png")
     assert all((line.get_ydata() == 0).all() for line in drawn[-1].axes[0].get_lines())
+
+
+def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_what_did_no_work(keep_figures,
+                                                                                               tmp_path):
+    from replication.report.figures import cost as cost_figures
+
+    drawn = keep_figures(cost_figures)
+    rows = [("PF", "N=100", 100, 0.1, [5.0, 5.2, 4.8]), ("PF", "N=500", 500, 0.4, [4.0, 4.1, 3.9]),
+            ("HSPF", "N=100", 2300, 1.8, [4.9, 5.1, 4.7]), ("SORT", "", 0, 0.01, [6.0, 6.0, 6.0])]
+    records = typed(pd.DataFrame([{"method": m, "condition": c, "repetition": r, "rmse": v,
+                                   "evaluations_per_step": e, "ms_per_step": s * (1 + 0.01 * r)}
+                                  for m, c, e, s, values in rows for r, v in enumerate(values)]))
+    experiment = {"methods": {}}
+    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png")
+    work, time = drawn[0].axes[:2]
+    pf = next(c for c in work.containers if c.get_label() == "PF").lines[0]
+    assert pf.get_xdata().tolist() == [100, 500] and pf.get_ydata() == pytest.approx([5.0, 4.0])  # ordered by cost
+    assert [c.get_label() for c in work.containers] == ["PF", "HSPF"]  # SORT counted no work
+    hspf = next(c for c in time.containers if c.get_label() == "HSPF").lines[0]
+    assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the mean time over runs
+    with pytest.raises(ValueError, match="the runs have no"):
+        figures.draw(records, {"kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png")

@@ -96,9 +96,10 @@ class MeanShiftMove:
         log_likelihood(particles[:1])  # makes the model cache this frame's bin image
         likelihood = self.model.likelihood
         bin_image = self.model.cache["prepared"]
-        moved, _ = mean_shift(
+        moved, iterations = mean_shift(
             particles, bin_image, likelihood.histogram, likelihood.reference, self.max_iter, self.eps
         )
+        self.model.spend(int(iterations.sum()), self.model.cache["t"])  # a histogram per box per iteration
         return moved, log_compensation(particles, moved, self.compensation)
 
 

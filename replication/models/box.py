@@ -125,6 +125,11 @@ class BoxModel:
         and by the other targets' models that share ``cache``."""
         return self.likelihood.log_likelihood(particles[:, :4], self.prepared(frame, t))
 
+    def spend(self, evaluations: int, t: int) -> None:
+        """Work a method does on this model's observation outside :meth:`log_likelihood` (a mean-shift
+        iteration computes a box's histogram, as a likelihood evaluation does); counted by
+        :class:`replication.smc.work.Counted`, nothing to do here."""
+
     def similarity(self, states: np.ndarray, frame: np.ndarray, t: int) -> np.ndarray:
         """The Bhattacharyya coefficient rho of each state's box against the reference (the frame's
         features shared with :meth:`log_likelihood` through ``cache``)."""

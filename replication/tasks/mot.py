@@ -35,6 +35,7 @@ from replication.metrics.mot import (
 from replication.models.boosted import BoostedBoxModel
 from replication.run import Run
 from replication.scenes.mot import MOT_ROOT, load_mot
+from replication.smc.work import Counted, Work
 from replication.tasks.tracking import histogram_args
 from replication.vision.colour import ColourLikelihood
 from replication.vision.histogram import ColourHistogram
@@ -73,15 +74,16 @@ def _tracker(run_model: dict, method, new_model) -> ParticleTracker | DetectionT
     )
 
 
-def _model_builder(run_model: dict, rng: np.random.Generator):
-    """``new_model(image, box)``: a target's model with its colour reference from ``box`` (cx, cy, w, h) in ``image``."""
+def _model_builder(run_model: dict, rng: np.random.Generator, work: Work):
+    """``new_model(image, box)``: a target's model with its colour reference from ``box`` (cx, cy, w, h) in
+    ``image``, its work counted into ``work``."""
     observation, cache = run_model.get("observation", {}), {}
 
-    def new_model(image: np.ndarray, box: np.ndarray) -> BoostedBoxModel:
+    def new_model(image: np.ndarray, box: np.ndarray) -> Counted:
         histogram = ColourHistogram(**histogram_args(observation, box[2:4], rng))
         likelihood = ColourLikelihood.from_frame(image, box, histogram, observation.get("sigma", 0.1))
-        return BoostedBoxModel(box, likelihood, cache=cache, detection_term=run_model.get("detection_term"),
-                               **run_model.get("motion", {}), **run_model.get("proposal", {}))
+        return Counted(BoostedBoxModel(box, likelihood, cache=cache, detection_term=run_model.get("detection_term"),
+                                       **run_model.get("motion", {}), **run_model.get("proposal", {})), work)
 
     return new_model
 
@@ -119,7 +121,9 @@ def run(run: Run) -> dict:
     spec = run.model["scene_spec"]
     sequence = sequence_of(spec["name"], spec.get("root", MOT_ROOT))
     frames = frames_of(spec, sequence)
-    tracker = _tracker(run.model, build_filter(run.method, run.method_params), _model_builder(run.model, run.rng("pattern")))
+    work = Work()  # every target's model counts into it (replication.smc.work); none for a detection reference
+    new_model = _model_builder(run.model, run.rng("pattern"), work)
+    tracker = _tracker(run.model, build_filter(run.method, run.method_params), new_model)
     rows = [
         (frame, int(i), *box)
         for frame, ids, boxes in tracker.track(sequence, frames, run.rng("filter"))
@@ -150,6 +154,7 @@ def run(run: Run) -> dict:
         **breakdown(tracker.counts, run.model.get("proposal", {}).get("alpha", 0.5)),
         **({"detection_iou": detection_overlap(tracks, used)} if len(tracks) else {}),
         "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
+        **work.record(len(frames)),
         "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),
     }

@@ -6,6 +6,7 @@ from replication.filters import build_filter
 from replication.metrics import filter_diagnostics, rmse
 from replication.models import MODELS
 from replication.run import Run
+from replication.smc.work import Counted, Work
 
 
 def build_model(params: dict):
@@ -23,16 +24,18 @@ def run(run: Run) -> dict:
 
     Every method at the same model condition and repetition sees the same
     trajectory (common random numbers), so paired differences between
-    methods are much tighter than the unpaired intervals suggest.
+    methods are much tighter than the unpaired intervals suggest.  The work
+    it did is counted on its model (:mod:`replication.smc.work`).
     """
     model = build_model(run.model)
     states, observations = model.simulate(run.rng("data"))
-    method = build_filter(run.method, run.method_params)
+    method, work = build_filter(run.method, run.method_params), Work()
     started = time.perf_counter()
-    output = method.run(model, observations, run.rng("filter"))
+    output = method.run(Counted(model, work), observations, run.rng("filter"))
     elapsed = time.perf_counter() - started
     return {
         "rmse": rmse(output.means, states),
         "ms_per_step": 1000.0 * elapsed / model.steps,
+        **work.record(model.steps),
         **filter_diagnostics(output),
     }

@@ -27,6 +27,7 @@ from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
 from replication.run import Run
 from replication.scenes.factory import cached_sequence
+from replication.smc.work import Counted, Work
 from replication.vision.colour import ColourLikelihood
 from replication.vision.fusion import FusionLikelihood
 from replication.vision.histogram import ColourHistogram
@@ -168,8 +169,9 @@ def run(run: Run) -> dict:
     sequence = cached_sequence(spec)
     chosen = targets(run.model, sequence.truth.shape[1])
     cache: dict = {}
+    work = Work()  # every target's model counts into it (replication.smc.work)
     tracker = make_tracker(lambda: build_filter(run.method, run.method_params))
-    tracker.start({t: build_model(run, sequence, t, cache) for t in chosen}, run.rng)
+    tracker.start({t: Counted(build_model(run, sequence, t, cache), work) for t in chosen}, run.rng)
     strip = spec.get("strip")  # a target whose marginal over x or y is kept per frame
     collectors = {"alpha": Adaptation(0)}  # fusion_pf's alpha_k, first target
     if strip:
@@ -194,6 +196,7 @@ def run(run: Run) -> dict:
         "ms_per_frame": 1000.0 * seconds / (sequence.n_frames - 1),
         "filter_s": seconds,  # the whole sequence, frame production excluded
         "fps": (sequence.n_frames - 1) / seconds,
+        **work.record(sequence.n_frames - 1),  # per filtered frame, all targets
         "mean_ess": float(np.mean([d["mean_ess"] for d in diagnostics])),
         "resample_count": float(np.mean([d["resample_count"] for d in diagnostics])),
         "resample_rate": float(np.mean([d["resample_rate"] for d in diagnostics])),  # % of filtered frames
@@ -220,6 +223,7 @@ def run(run: Run) -> dict:
         "targets": chosen,
         "ess": [None] + np.round(np.mean([o.ess for o in outputs], axis=0), 2).tolist(),
         "seconds": [None] + np.round(tracker.frame_seconds, 7).tolist(),  # per filtered frame, all targets
+        "evaluations": [None] + work.per_step(range(1, sequence.n_frames)),  # likelihood evaluations, all targets
     }
     if collectors["alpha"].value is not None:  # fusion_pf's alpha_k, first target
         record["per_frame"]["alpha"] = [None] + np.round(collectors["alpha"].value, 4).tolist()

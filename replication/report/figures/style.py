@@ -120,6 +120,7 @@ LABELS = {  # metric, per-frame series or swept variable -> axis label
     "rmse": "RMSE",
     "ms_per_step": "time per step (ms)",
     "ms_per_frame": "time per frame (ms)",
+    "evaluations_per_step": "likelihood evaluations per step",
     "filter_s": "filtering time (s)",
     "fps": "frames per second",
     "mean_ess": "mean effective sample size",

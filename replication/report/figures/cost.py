@@ -1,0 +1,52 @@
+"""Error against cost: a method below another's line at equal cost is better at that budget, whatever the
+particle counts (the SMC literature's comparison at equal work: Gerber and Chopin, JRSS B 2015)."""
+
+import textwrap
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from replication.condition import label_of  # noqa: E402
+from replication.evidence.aggregate import summarise  # noqa: E402
+from replication.report.figures.base import figure  # noqa: E402
+from replication.report.figures.style import axis_label, method_label, method_look, save  # noqa: E402
+
+COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted, and the time it took
+
+
+@figure("metric_vs_cost")
+def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """``spec.metric`` (mean and 95% interval over runs) against each cost of ``spec.costs`` (mean over
+    runs, log scale), one panel per cost; a method's conditions (its particle counts, say) are joined by
+    a line in order of cost, its other swept variables ``spec.by`` (a scene) split into lines of their own."""
+    metric, costs = spec["metric"], spec.get("costs", list(COSTS))
+    missing = [c for c in (metric, *costs) if c not in records]
+    if missing:
+        raise ValueError(f"figure {spec.get('name', 'metric_vs_cost')!r}: the runs have no {missing}")
+    y = summarise(records, metric)
+    y["line"] = label_of(y, without=[v for v in _swept(y) if v != spec.get("by")], sep=" ") if spec.get("by") else ""
+    fig, axes = plt.subplots(1, len(costs), figsize=(6 * len(costs), 4.4), squeeze=False)
+    for ax, cost in zip(axes[0], costs):
+        x = summarise(records, cost)[["method", "condition", "mean"]].rename(columns={"mean": "cost"})
+        points = y.merge(x, on=["method", "condition"])
+        points = points[points["cost"] > 0]  # no work counted: a reference without a likelihood
+        for (method, line), group in points.groupby(["method", "line"], sort=False):
+            group = group.sort_values("cost")
+            interval = [group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]]
+            ax.errorbar(group["cost"], group["mean"], yerr=interval, **method_look(method).line(), markersize=5,
+                        capsize=2, elinewidth=0.8, label=f"{method_label(experiment, method)} {line}".strip())
+        ax.set_xscale("log")
+        ax.set_xlabel(axis_label(cost) + " (mean over runs, log scale)")
+        ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
+        ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(textwrap.fill(spec.get("title", ""), 120), fontsize=9)
+    axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    return save(fig, path, dpi=120)
+
+
+def _swept(summary: pd.DataFrame) -> list[str]:
+    return [c.removeprefix("condition.") for c in summary.columns if c.startswith("condition.")]
