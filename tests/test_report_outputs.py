@@ -342,7 +342,7 @@ def test_pages_in_headless_chromium(reports, tmp_path):
             rows = seen["dom"].split('id="cells"', 1)[1].split("</table>", 1)[0].count("<tr")
             assert rows == 1 + len(load_published(str(PUBLISHED)))
         else:
-            assert len(parser.images) == 3  # rmse_vs_n, ess_vs_n, point_sets
+            assert len(parser.images) == 4  # rmse_vs_n, ess_vs_n, rmse_vs_cost, point_sets
     assert _valid_png(reports / "screenshot.png") == (1280, 2000)  # python -m replication.report screenshot=true
 
 
