@@ -108,3 +108,21 @@ def test_mean_shift_counts_a_histogram_per_box_per_iteration_beside_the_likeliho
         work = Work()
         FILTERS["mspf"](n_particles=50, max_iter=max_iter).run(counted(work), [image] * 3, np.random.default_rng(0))
         assert all(low <= n <= high for n in work.evaluations.values()) and len(work.evaluations) == 3
+
+
+def test_harmony_search_scores_its_memory_every_improvisation_and_the_weighting():
+    """HSPF without its stopping rules: per particle HMS harmonies, then NI improvisations, then the loop's
+    weighting: N (HMS + NI + 1) per step."""
+    hspf = FILTERS["hspf"](n_particles=20, ni=4, hms=3, radius=2.0, idle=None, precision=None, quality=None)
+    work, *_ = _counted_run(hspf)
+    assert set(work.evaluations.values()) == {20 * (3 + 4 + 1)}
+
+
+def test_ism_scores_the_predicted_particles_and_weights_the_moved_ones():
+    """ISM-PF as written: the sharing move scores the N predicted particles and the loop weights the N moved
+    ones, 2N per step; re-scoring the personal bests' window on each frame adds N per earlier frame kept."""
+    for bests, expected in (("stored", [50, 50, 50, 50]), ("rescored", [50, 75, 100, 125])):
+        work = Work()
+        model = Counted(BoxModel(np.array([50.0, 40, 10, 10]), _Flat(), step_sd=(1.0, 1.0, 0.1, 0.1)), work)
+        FILTERS["ism"](n_particles=25, bests=bests).run(model, [np.zeros((80, 120, 3))] * 4, np.random.default_rng(0))
+        assert work.per_step(range(1, 5)) == expected

@@ -9,9 +9,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from replication.condition import label_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
+from replication.evidence.quantities import quantity  # noqa: E402
 from replication.report.figures.base import figure  # noqa: E402
 from replication.report.figures.style import axis_label, method_label, method_look, save  # noqa: E402
 
@@ -21,8 +23,9 @@ COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted,
 @figure("metric_vs_cost")
 def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """``spec.metric`` (mean and 95% interval over runs) against each cost of ``spec.costs`` (mean over
-    runs, log scale), one panel per cost; a method's conditions (its particle counts, say) are joined by
-    a line in order of cost, its other swept variables ``spec.by`` (a scene) split into lines of their own."""
+    runs; a time's median, which a slow first run does not move; log scale), one panel per cost; a
+    method's conditions (its particle counts, say) are joined by a line in order of cost, its other
+    swept variable ``spec.by`` (a scene) split into lines of their own."""
     metric, costs = spec["metric"], spec.get("costs", list(COSTS))
     missing = [c for c in (metric, *costs) if c not in records]
     if missing:
@@ -31,7 +34,9 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
     y["line"] = label_of(y, without=[v for v in _swept(y) if v != spec.get("by")], sep=" ") if spec.get("by") else ""
     fig, axes = plt.subplots(1, len(costs), figsize=(6 * len(costs), 4.4), squeeze=False)
     for ax, cost in zip(axes[0], costs):
-        x = summarise(records, cost)[["method", "condition", "mean"]].rename(columns={"mean": "cost"})
+        statistic = "median" if quantity(cost).machine_dependent else "mean"  # a time: robust to a slow first run
+        x = summarise(records, cost, statistic=statistic)[["method", "condition", "mean"]]
+        x = x.rename(columns={"mean": "cost"})
         points = y.merge(x, on=["method", "condition"])
         points = points[points["cost"] > 0]  # no work counted: a reference without a likelihood
         for (method, line), group in points.groupby(["method", "line"], sort=False):
@@ -40,7 +45,9 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
             ax.errorbar(group["cost"], group["mean"], yerr=interval, **method_look(method).line(), markersize=5,
                         capsize=2, elinewidth=0.8, label=f"{method_label(experiment, method)} {line}".strip())
         ax.set_xscale("log")
-        ax.set_xlabel(axis_label(cost) + " (mean over runs, log scale)")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel(f"{axis_label(cost)} ({statistic} over runs, log scale)")
         ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(textwrap.fill(spec.get("title", ""), 120), fontsize=9)
