@@ -370,7 +370,8 @@ def test_tab_completion_offers_experiments_and_keys():
         assert done.returncode == 0, done.stderr
         return done.stdout.split()
 
-    assert complete("pf-replicate experiment=hspf_u") == ["experiment=hspf_ungm", "experiment=hspf_ungm_sweep"]
+    assert complete("pf-replicate experiment=hspf_u") == [
+        "experiment=hspf_ungm", "experiment=hspf_ungm_cost", "experiment=hspf_ungm_sweep"]
     assert "scale=" in complete("pf-replicate experiment=hspf sc")
 
 
