@@ -9,7 +9,8 @@ defensible reading.
 
 A reading names an experiment and a *test*, a small class registered by
 name (:class:`ClaimTest`): ``order`` (paired differences between methods on
-common random numbers), ``cells`` (the verdicts of published cells in named
+common random numbers), ``equal_cost`` (the same at equal work: the baseline at the
+budget the method spends), ``cells`` (the verdicts of published cells in named
 tables), ``threshold`` (a statistic against a bound), ``best`` (a method
 first over several sequences, decided by its probability of ranking first) and
 ``uniformity`` (discrepancies of point sets, no runs).  Each test returns
@@ -229,6 +230,46 @@ class Order(ClaimTest):
         if any(len(v) != 1 or not np.isfinite(v.iloc[0]) for v in values):
             return None
         return Effect(float(values[0].iloc[0]), float(values[1].iloc[0]), size.get("kind", "difference"))
+
+
+class EqualCost(ClaimTest):
+    """``method`` beats ``baseline`` on ``metric`` with the baseline given at least the method's budget, at
+    each of the method's ``conditions``: of the baseline's conditions (an N sweep), the cheapest whose
+    ``cost`` over runs (the mean of a count such as ``evaluations_per_step``; the median of a time) reaches
+    the method's there; paired by run on the same data, tested as ``order`` tests a pair.  A claim made at
+    equal N, read at equal cost.  No baseline condition reaching the budget: not testable, and said."""
+
+    name = "equal_cost"
+
+    def checks(self, records, tables):
+        metric, cost, method, baseline = (self.spec[k] for k in ("metric", "cost", "method", "baseline"))
+        statistic = "median" if quantity(cost).machine_dependent else "mean"
+        theirs = records[records["method"] == baseline]
+        spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
+        found = []
+        for condition in self.conditions(records[records["method"] == method]):
+            ours = records[(records["method"] == method) & (records["condition"] == condition)]
+            if ours.empty or theirs.empty:
+                continue
+            budget = float(ours[cost].agg(statistic))
+            at = f" at {condition}" if condition else ""
+            what = f"{method}{at} - {baseline} at equal {quantity(cost).label or cost} ({budget:.4g})"
+            reaching = spent[spent >= budget]
+            if reaching.empty:
+                why = f"no condition of {baseline} reaches the budget (at most {spent.max():.4g})"
+                found.append(Check(what, Verdict(Outcome.NOT_TESTABLE, why)))
+                continue
+            chosen = reaching.index[0]
+            keys = ["data_condition", "repetition"]
+            paired = ours[[*keys, metric]].merge(theirs[theirs["condition"] == chosen][[*keys, metric]], on=keys,
+                                                 suffixes=("_method", "_baseline"))
+            paired = paired[np.isfinite(paired[[f"{metric}_method", f"{metric}_baseline"]]).all(axis=1)]
+            better, worse = (paired[f"{metric}_{side}"].to_numpy(float) for side in ("method", "baseline"))
+            verdict, difference = _order_check(better, worse, quantity(metric), 1.0, 0.0, None)
+            per_run = dict(zip(paired["repetition"].astype(int), better - worse))
+            found.append(Check(f"{what}: {baseline} at {chosen} ({spent[chosen]:.4g})", verdict, difference,
+                               self.spec.get("unit", ""), 0.0, per_run))
+        return found
 
 
 def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allowed: float,
