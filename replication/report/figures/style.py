@@ -45,7 +45,7 @@ class Look:
 METHODS = {  # config key -> look; every method of conf/experiment/*.yaml
     # plain particle filters
     "PF": Look(BLUE, "-", "o"),
-    "PF-N": Look(BLUE, ":", "<"),  # the bootstrap PF over an N sweep, for error against cost
+    "PF-N": Look(BLUE, ":", "<"),  # the bootstrap PF over an N sweep, for error against cost (hspf, gps_qmcpf)
     "MIPF": Look(BLUE, "-", "s"),
     "color-only PF": Look(BLUE, "--", "s"),
     "colour-sigma-0.1": Look(SKY, "--", "s"),
