@@ -87,21 +87,24 @@ def test_order_uses_paired_differences():
 
 def test_equal_cost_pairs_the_method_with_the_cheapest_baseline_condition_that_reaches_its_budget():
     """HSPF-like M spends 1100 evaluations per step at N = 100; the baseline B is swept over N, spending N:
-    the check pairs M with B at N = 2000 (the cheapest reaching 1100), run by run on the same data."""
+    the check pairs M with B at N = 1400 (the cheapest reaching 1100), run by run on the same data."""
     rng = np.random.default_rng(2)
     base = rng.normal(5.0, 1.0, 20)
     rows = [{"method": "M", "condition": "N=100", "evaluations_per_step": 1100.0, "rmse": base[r] + 0.3}
             for r in range(20)]
     rows += [{"method": "B", "condition": f"N={n}", "evaluations_per_step": float(n),
               "rmse": base[r] + 1.0 / np.sqrt(n) + 0.01 * rng.standard_normal()}
-             for n in (250, 500, 1000, 2000, 4000) for r in range(20)]
+             for n in (250, 500, 1000, 1400, 2000, 4000) for r in range(20)]
     records = typed(pd.DataFrame([{**row, "data_condition": "", "repetition": i % 20} for i, row in enumerate(rows)]))
     spec = {"test": "equal_cost", "metric": "rmse", "method": "M", "baseline": "B", "cost": "evaluations_per_step"}
     (check,) = ClaimTest.of(spec, EXPERIMENT).checks(records, {})
-    assert check.what.endswith("B at N=2000 (2000)") and "(1100)" in check.what
-    assert check.estimate.value == pytest.approx(0.3 - 1.0 / np.sqrt(2000), abs=0.01)  # M worse, paired
+    assert check.what.endswith("B at N=1400 (1400)") and "(1100)" in check.what
+    assert check.estimate.value == pytest.approx(0.3 - 1.0 / np.sqrt(1400), abs=0.01)  # M worse, paired
     assert check.verdict.outcome is Outcome.NOT_REPRODUCED
-    poor = records[~records["condition"].isin(["N=2000", "N=4000"])]  # no B condition reaches 1100
+    elsewhere = records.assign(data_condition=np.where(records["condition"] == "N=1400", "scene=b", ""))
+    (check,) = ClaimTest.of(spec, EXPERIMENT).checks(elsewhere, {})
+    assert check.what.endswith("B at N=2000 (2000)")  # an N run on other data (another scene) is not a budget
+    poor = records[~records["condition"].isin(["N=1400", "N=2000", "N=4000"])]  # no B condition reaches 1100
     (untestable,) = ClaimTest.of(spec, EXPERIMENT).checks(poor, {})
     assert untestable.verdict.outcome is Outcome.NOT_TESTABLE and "at most 1000" in untestable.verdict.why
 

@@ -234,7 +234,8 @@ class Order(ClaimTest):
 
 class EqualCost(ClaimTest):
     """``method`` beats ``baseline`` on ``metric`` with the baseline given at least the method's budget, at
-    each of the method's ``conditions``: of the baseline's conditions (an N sweep), the cheapest whose
+    each of the method's ``conditions``: of the baseline's conditions on the same data (an N sweep on the
+    same scene), the cheapest whose
     ``cost`` over runs (the mean of a count such as ``evaluations_per_step``; the median of a time) reaches
     the method's there; paired by run on the same data, tested as ``order`` tests a pair.  A claim made at
     equal N, read at equal cost.  No baseline condition reaching the budget: not testable, and said."""
@@ -244,13 +245,14 @@ class EqualCost(ClaimTest):
     def checks(self, records, tables):
         metric, cost, method, baseline = (self.spec[k] for k in ("metric", "cost", "method", "baseline"))
         statistic = "median" if quantity(cost).machine_dependent else "mean"
-        theirs = records[records["method"] == baseline]
-        spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
         found = []
         for condition in self.conditions(records[records["method"] == method]):
             ours = records[(records["method"] == method) & (records["condition"] == condition)]
+            theirs = records[(records["method"] == baseline)  # on the same data (scene) as ours
+                             & records["data_condition"].isin(ours["data_condition"].unique())]
             if ours.empty or theirs.empty:
                 continue
+            spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
             budget = float(ours[cost].agg(statistic))
             at = f" at {condition}" if condition else ""
             what = f"{method}{at} - {baseline} at equal {quantity(cost).label or cost} ({budget:.4g})"
