@@ -56,9 +56,10 @@ SEED = 20261125
 DISTRIBUTIONS = ("normal", "t3", "lognormal")
 LOGNORMAL_SIGMA = 0.5
 # The paired run counts the claims' experiments use: 5 (bis_pf, ism_pf quick; hspf's runs per sequence),
-# 6 (fusion_pf quick), 10 (bis_pf paper), 20 (gps_qmcpf, hspf_ungm quick; helicopter paper), 50 (fusion_pf
-# paper), 100 (gps_qmcpf, hspf_ungm, ism_pf paper).  tests/test_calibration.py checks the list is complete.
-RUNS = (5, 6, 10, 20, 50, 100)
+# 6 (fusion_pf quick), 10 (bis_pf paper), 20 (gps_qmcpf, hspf_ungm quick; helicopter paper), 30
+# (ism_pf_particles paper: ism_pf.accuracy at equal cost), 50 (fusion_pf paper), 100 (gps_qmcpf, hspf_ungm,
+# ism_pf paper).  tests/test_calibration.py checks the list is complete.
+RUNS = (5, 6, 10, 20, 30, 50, 100)
 CHAINS = (6, 9)  # checks in a reading: ism_pf.accuracy (2 pairs x 3 scenes), gps_qmcpf.rmse (3 x 3)
 EFFECTS = (0.5, 1.0)
 COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "rate", "mc_se", "wrong_rate",
