@@ -13,8 +13,8 @@ number is a config value and our choice (``conf/experiment/bis_pf_pets.yaml`` sa
   track, born at its last detection.
 * :class:`Deleter`: a track is supported in a frame by an associated detection or by its
   own appearance (the colour similarity rho of its estimate to its reference at least
-  ``min_rho``; ``None``: by detections alone, as tracking-by-detection does); it dies after ``frames`` consecutive frames without support, or at once
-  when its centre leaves the image.
+  ``min_rho``; ``None``: by detections alone, as tracking-by-detection does); it dies after
+  ``frames`` consecutive frames without support, or at once when its centre leaves the image.
 """
 
 from dataclasses import dataclass, field
@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from replication.metrics.mot import iou_matrix, match_boxes
-from replication.metrics.tracking import centres
+from replication.metrics.tracking import outside_image
 
 
 def associate(tracks: np.ndarray, detections: np.ndarray, min_iou: float) -> np.ndarray:
@@ -75,12 +75,6 @@ class Deleter:
         return detected if self.min_rho is None else detected | (rho >= self.min_rho)
 
     def causes(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> dict[str, np.ndarray]:
-        """Why each track would die: ``unsupported`` frames in a row reach ``frames``; its box's centre is
-        outside the image."""
-        centre = centres(boxes)
-        outside = (centre < 0).any(axis=1) | (centre[:, 0] >= size[0]) | (centre[:, 1] >= size[1])
-        return {"unsupported": unsupported >= self.frames, "outside": outside}
-
-    def dead(self, unsupported: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-        """Which tracks die, for either cause of :meth:`causes`."""
-        return np.logical_or.reduce(list(self.causes(unsupported, boxes, size).values()))
+        """Why each track dies (either cause kills it): ``unsupported`` frames in a row reach ``frames``; its
+        box's centre is outside the image."""
+        return {"unsupported": unsupported >= self.frames, "outside": outside_image(boxes, size)}
