@@ -235,9 +235,9 @@ class Order(ClaimTest):
 class EqualCost(ClaimTest):
     """``method`` beats ``baseline`` on ``metric`` with the baseline given at least the method's budget, at
     each of the method's ``conditions``: of the baseline's conditions on the same data (an N sweep on the
-    same scene), the cheapest whose
-    ``cost`` over runs (the mean of a count such as ``evaluations_per_step``; the median of a time) reaches
-    the method's there; paired by run on the same data, tested as ``order`` tests a pair.  A claim made at
+    same scene), the cheapest whose ``cost`` over runs (the mean of a count such as ``evaluations_per_step``;
+    the median of a time) reaches the method's there; paired by run on the same data, tested as ``order``
+    tests a pair.  A claim made at
     equal N, read at equal cost.  No baseline condition reaching the budget: not testable, and said."""
 
     name = "equal_cost"
@@ -262,11 +262,9 @@ class EqualCost(ClaimTest):
                 found.append(Check(what, Verdict(Outcome.NOT_TESTABLE, why)))
                 continue
             chosen = reaching.index[0]
-            keys = ["data_condition", "repetition"]
-            paired = ours[[*keys, metric]].merge(theirs[theirs["condition"] == chosen][[*keys, metric]], on=keys,
-                                                 suffixes=("_method", "_baseline"))
-            paired = paired[np.isfinite(paired[[f"{metric}_method", f"{metric}_baseline"]]).all(axis=1)]
-            better, worse = (paired[f"{metric}_{side}"].to_numpy(float) for side in ("method", "baseline"))
+            paired = pair(records, metric, baseline, method, condition, baseline_condition=chosen)
+            paired = paired[np.isfinite(paired[["baseline", "method"]]).all(axis=1)]  # both defined
+            better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
             verdict, difference = _order_check(better, worse, quantity(metric), 1.0, 0.0, None)
             per_run = dict(zip(paired["repetition"].astype(int), better - worse))
             found.append(Check(f"{what}: {baseline} at {chosen} ({spent[chosen]:.4g})", verdict, difference,

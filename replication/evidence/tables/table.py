@@ -183,14 +183,19 @@ class TableKind:
                           estimate=estimate, rating=rating, verdict=verdict)
 
 
-def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None):
+def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, condition: str | None = None,
+         baseline_condition: str | None = None):
     """``metric`` of two methods run on the same data (same data condition and repetition), side by side:
     columns ``baseline``, ``method`` and ``repetition``, one row per shared repetition (at ``condition`` if
-    given)."""
+    given; the baseline at ``baseline_condition`` instead if given: another N on the same data)."""
     columns = ["data_condition", "repetition", metric]
-    chosen = records if condition is None else records[records["condition"] == condition]
-    left = chosen[chosen["method"] == baseline][columns]
-    right = chosen[chosen["method"] == method][columns]
+
+    def at(name: str, where: str | None) -> pd.DataFrame:
+        runs = records[records["method"] == name]
+        return (runs if where is None else runs[runs["condition"] == where])[columns]
+
+    left = at(baseline, baseline_condition or condition)
+    right = at(method, condition)
     paired = left.merge(right, on=["data_condition", "repetition"], suffixes=("_baseline", "_method"))
     return pd.DataFrame({"baseline": paired[f"{metric}_baseline"].astype(float),
                          "method": paired[f"{metric}_method"].astype(float), "repetition": paired["repetition"]})
