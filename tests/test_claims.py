@@ -11,7 +11,7 @@ from conftest import typed
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
-from replication.evidence.claims import Check, ClaimTest, Result, load_papers
+from replication.evidence.claims import Check, ClaimTest, Reading, Result, load_papers
 from replication.evidence.published import load_published
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
@@ -42,7 +42,8 @@ def test_every_reading_names_a_real_experiment_methods_and_tables():
                     test = reading.test
                     ClaimTest.of(test, experiment)  # a known test
                     named = [m for g in test.get("order", []) for m in ([g] if isinstance(g, str) else g)]
-                    named += [test[k] for k in ("method", "baseline") if k in test]
+                    named += [m for k in ("method", "baseline") if k in test
+                              for m in ([test[k]] if isinstance(test[k], str) else test[k])]
                     assert set(named) <= set(experiment["methods"]), (claim.id, reading.name)
                     tables = {t["name"] for t in experiment["report"]["tables"]}
                     assert set(test.get("tables", [])) <= tables, (claim.id, reading.name)
@@ -98,15 +99,40 @@ def test_equal_cost_pairs_the_method_with_the_cheapest_baseline_condition_that_r
     records = typed(pd.DataFrame([{**row, "data_condition": "", "repetition": i % 20} for i, row in enumerate(rows)]))
     spec = {"test": "equal_cost", "metric": "rmse", "method": "M", "baseline": "B", "cost": "evaluations_per_step"}
     (check,) = ClaimTest.of(spec, EXPERIMENT).checks(records, {})
-    assert check.what.endswith("B at N=1400 (1400)") and "(1100)" in check.what
+    assert check.detail == "budget 1100; B at N=1400 spends 1400"
+    assert check.what == "M at N=100 - B at equal likelihood evaluations per step"  # its identity, free of budgets
     assert check.estimate.value == pytest.approx(0.3 - 1.0 / np.sqrt(1400), abs=0.01)  # M worse, paired
     assert check.verdict.outcome is Outcome.NOT_REPRODUCED
     elsewhere = records.assign(data_condition=np.where(records["condition"] == "N=1400", "scene=b", ""))
     (check,) = ClaimTest.of(spec, EXPERIMENT).checks(elsewhere, {})
-    assert check.what.endswith("B at N=2000 (2000)")  # an N run on other data (another scene) is not a budget
+    assert check.detail.endswith("B at N=2000 spends 2000")  # an N run on other data (another scene) is not a budget
+    # several methods and baselines: each method against each baseline, a check each (Holm across them)
+    twice = pd.concat([records, records.assign(method=records["method"].map({"M": "M2", "B": "B2"}))])
+    listed = {**spec, "method": ["M", "M2"], "baseline": ["B", "B2"]}
+    checks = ClaimTest.of(listed, EXPERIMENT).checks(typed(twice.reset_index(drop=True)), {})
+    assert [c.what.split(" - ")[0] + " / " + c.what.split(" - ")[1].split(" at ")[0] for c in checks] == [
+        "M at N=100 / B", "M at N=100 / B2", "M2 at N=100 / B", "M2 at N=100 / B2"]
+    assert {c.estimate.value for c in checks} == {checks[0].estimate.value}  # the same runs under each name
+    assert Reading("r", "e", spec).basis == "likelihood evaluations per step"
+    assert Reading("r", "e", {"test": "order", "order": ["M", "B"]}).basis == ""  # the paper's: equal N
     poor = records[~records["condition"].isin(["N=1400", "N=2000", "N=4000"])]  # no B condition reaches 1100
     (untestable,) = ClaimTest.of(spec, EXPERIMENT).checks(poor, {})
     assert untestable.verdict.outcome is Outcome.NOT_TESTABLE and "at most 1000" in untestable.verdict.why
+
+
+def test_a_comparison_of_times_shows_the_work_of_each_side():
+    """A cost claim's check (a time) carries each method's likelihood evaluations per step beside it, so a
+    slower code can be told from more work; a comparison of accuracy does not."""
+    records = _records({"A": 0.0, "B": 0.2}, metric="ms_per_step")
+    records["evaluations_per_step"] = np.where(records["method"] == "A", 100.0, 1100.0)
+    (check,) = ClaimTest.of({"test": "order", "metric": "ms_per_step", "order": ["A", "B"]}, EXPERIMENT) \
+        .checks(records, {})
+    assert check.detail == "likelihood evaluations per step: A 100, B 1100"
+    assert check.shown == f"{check.what} ({check.detail})"
+    accuracy = _records({"A": 0.0, "B": 0.2}).assign(evaluations_per_step=100.0)
+    (check,) = ClaimTest.of({"test": "order", "metric": "rmse", "order": ["A", "B"]}, EXPERIMENT) \
+        .checks(accuracy, {})
+    assert check.detail == "" and check.shown == check.what
 
 
 def test_inconclusive_says_what_the_runs_could_detect():

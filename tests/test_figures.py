@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from scipy import stats
 from matplotlib.colors import to_hex
 
 from conftest import typed
@@ -242,10 +243,15 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
     experiment = {"methods": {}}
     figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png")
     work, time = drawn[0].axes[:2]
-    pf = next(c for c in work.containers if c.get_label() == "PF").lines[0]
+    pf = next(line for line in work.get_lines() if line.get_label() == "PF")  # two budgets: a line and its band
     assert pf.get_xdata().tolist() == [100, 500] and pf.get_ydata() == pytest.approx([5.0, 4.0])  # ordered by cost
-    assert [c.get_label() for c in work.containers] == ["PF", "HSPF"]  # SORT counted no work
+    (band,) = work.collections[:1]
+    low, high = band.get_paths()[0].vertices[:, 1].min(), band.get_paths()[0].vertices[:, 1].max()
+    assert low == pytest.approx(4.0 - stats.t.ppf(0.975, 2) * 0.1 / np.sqrt(3)) and high > 5.0  # the 95% t band
+    assert [c.get_label() for c in work.containers] == ["HSPF"]  # one budget: a point with its interval
+    labels = [line.get_label() for line in work.get_lines() if not line.get_label().startswith("_")]
+    assert "SORT" not in labels + [c.get_label() for c in work.containers]  # SORT counted no work
     hspf = next(c for c in time.containers if c.get_label() == "HSPF").lines[0]
-    assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the mean time over runs
+    assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the median time over runs
     with pytest.raises(ValueError, match="the runs have no"):
         figures.draw(records, {"kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png")

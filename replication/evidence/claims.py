@@ -41,6 +41,7 @@ from replication.evidence.tables import Table, match, pair
 from replication.evidence.settings import INFERENCE
 
 CLAIMS_DIR = CONF_DIR / "claims"
+WORK = "evaluations_per_step"  # the work counted beside a time (replication.smc.work)
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,12 @@ class Reading:
     name: str
     experiment: str
     test: dict
+
+    @property
+    def basis(self) -> str:
+        """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
+        they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
+        return ClaimTest.registry[self.test["test"]].basis(self.test)
 
 
 @dataclass(frozen=True)
@@ -86,6 +93,11 @@ class Check:
     unit: str = ""
     reference: float | None = None  # where the claim's line is: the paper's value, a bound, zero difference
     per_run: dict[int, float] = field(default_factory=dict)  # the statistic per repetition (for the multiverse)
+    detail: str = ""  # what it was measured at (a budget, the work spent), shown beside ``what``, not its identity
+
+    @property
+    def shown(self) -> str:
+        return f"{self.what} ({self.detail})" if self.detail else self.what
 
     @property
     def number(self) -> str:
@@ -132,7 +144,7 @@ class Result:
         deciding = checks[i]
         held = sum(c.verdict.outcome is Outcome.REPRODUCED for c in checks)
         said = "; ".join(filter(None, [deciding.number, deciding.verdict.why]))
-        why = f"{held} of {len(testable)} checks hold; {deciding.what}" + (f": {said}" if said else "")
+        why = f"{held} of {len(testable)} checks hold; {deciding.shown}" + (f": {said}" if said else "")
         against = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_against[i]  # what decided it
         return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(against)), tuple(checks), deciding)
 
@@ -145,7 +157,7 @@ def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) ->
     why = f"{own.why}; not significant after Holm across {family} checks ({said_p(adjusted)})" \
         if own.outcome is Outcome.NOT_REPRODUCED else own.why
     return Check(check.what, Verdict(outcome, why, own.p_for, own.p_against), check.estimate, check.unit,
-                 check.reference, check.per_run)
+                 check.reference, check.per_run, check.detail)
 
 
 class ClaimTest:
@@ -170,6 +182,11 @@ class ClaimTest:
 
     def checks(self, records: pd.DataFrame, tables: dict[str, Table]) -> list[Check]:
         raise NotImplementedError
+
+    @classmethod
+    def basis(cls, spec: dict) -> str:
+        """The budget a reading by this test gives the methods in common ("": the paper's settings)."""
+        return ""
 
     @property
     def tables(self) -> list[str]:
@@ -213,7 +230,8 @@ class Order(ClaimTest):
                     verdict, difference = _order_check(better, worse, kind, scale, allowed,
                                                        self.effect(a, b, condition))
                     per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
-                    found.append(Check(what, verdict, difference, unit, 0.0, per_run))
+                    work = _work(records, (a, b), condition) if kind.machine_dependent else ""  # beside a time
+                    found.append(Check(what, verdict, difference, unit, 0.0, per_run, work))
         return found
 
     def effect(self, better: str, worse: str, condition: str) -> Effect | None:
@@ -233,17 +251,26 @@ class Order(ClaimTest):
 
 
 class EqualCost(ClaimTest):
-    """``method`` beats ``baseline`` on ``metric`` with the baseline given at least the method's budget, at
-    each of the method's ``conditions``: of the baseline's conditions on the same data (an N sweep on the
-    same scene), the cheapest whose ``cost`` over runs (the mean of a count such as ``evaluations_per_step``;
-    the median of a time) reaches the method's there; paired by run on the same data, tested as ``order``
-    tests a pair.  A claim made at
-    equal N, read at equal cost.  No baseline condition reaching the budget: not testable, and said."""
+    """Each ``method`` beats each ``baseline`` (one name or a list of either) on ``metric`` with the baseline
+    given at least the method's budget, at each of the method's ``conditions``: of the baseline's conditions
+    on the same data (an N sweep on the same scene), the cheapest whose ``cost`` over runs (the mean of a
+    count such as ``evaluations_per_step``; the median of a time) reaches the method's there; paired by run on
+    the same data, tested as ``order`` tests a pair.  A claim made at equal N, read at equal cost.  A baseline
+    that already spends more at the paper's N is compared there (it is given more than the budget, which can
+    only favour it).  No baseline condition reaching the budget: not testable, and said."""
 
     name = "equal_cost"
 
+    @classmethod
+    def basis(cls, spec):
+        return quantity(spec["cost"]).label or spec["cost"]
+
     def checks(self, records, tables):
-        metric, cost, method, baseline = (self.spec[k] for k in ("metric", "cost", "method", "baseline"))
+        metric, cost = self.spec["metric"], self.spec["cost"]
+        pairs = itertools.product(_listed(self.spec["method"]), _listed(self.spec["baseline"]))
+        return [check for method, baseline in pairs for check in self.pair(records, metric, cost, method, baseline)]
+
+    def pair(self, records: pd.DataFrame, metric: str, cost: str, method: str, baseline: str) -> list[Check]:
         statistic = "median" if quantity(cost).machine_dependent else "mean"
         found = []
         for condition in self.conditions(records[records["method"] == method]):
@@ -255,21 +282,34 @@ class EqualCost(ClaimTest):
             spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
             budget = float(ours[cost].agg(statistic))
             at = f" at {condition}" if condition else ""
-            what = f"{method}{at} - {baseline} at equal {quantity(cost).label or cost} ({budget:.4g})"
+            what = f"{method}{at} - {baseline} at equal {quantity(cost).label or cost}"
             reaching = spent[spent >= budget]
             if reaching.empty:
                 why = f"no condition of {baseline} reaches the budget (at most {spent.max():.4g})"
-                found.append(Check(what, Verdict(Outcome.NOT_TESTABLE, why)))
+                found.append(Check(what, Verdict(Outcome.NOT_TESTABLE, why), detail=f"budget {budget:.4g}"))
                 continue
             chosen = reaching.index[0]
             paired = pair(records, metric, baseline, method, condition, baseline_condition=chosen)
             paired = paired[np.isfinite(paired[["baseline", "method"]]).all(axis=1)]  # both defined
             better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-            verdict, difference = _order_check(better, worse, quantity(metric), 1.0, 0.0, None)
-            per_run = dict(zip(paired["repetition"].astype(int), better - worse))
-            found.append(Check(f"{what}: {baseline} at {chosen} ({spent[chosen]:.4g})", verdict, difference,
-                               self.spec.get("unit", ""), 0.0, per_run))
+            scale = self.spec.get("scale", 1.0)
+            verdict, difference = _order_check(better, worse, quantity(metric), scale, 0.0, None)
+            per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
+            spends = f"budget {budget:.4g}; {baseline} at {chosen} spends {spent[chosen]:.4g}"
+            found.append(Check(what, verdict, difference, self.spec.get("unit", ""), 0.0, per_run, spends))
         return found
+
+
+def _work(records: pd.DataFrame, methods: tuple[str, ...], condition: str) -> str:
+    """The likelihood evaluations per step each of ``methods`` spends at ``condition`` (mean over runs), shown
+    beside a comparison of times, so a slower code can be told from more work ("" where the runs count none)."""
+    if WORK not in records:
+        return ""
+    at = records[records["condition"] == condition] if condition else records
+    spent = [at.loc[at["method"] == m, WORK].mean() for m in methods]
+    if not all(np.isfinite(spent)):
+        return ""
+    return f"{quantity(WORK).label}: " + ", ".join(f"{m} {w:.4g}" for m, w in zip(methods, spent))
 
 
 def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allowed: float,

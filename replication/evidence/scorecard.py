@@ -44,6 +44,11 @@ class ClaimRow:
         return self.primary.verdict
 
     @property
+    def at_equal_cost(self) -> list[ReadingResult]:
+        """Its readings with the methods given the same budget (not the paper's reading), beside the primary."""
+        return [r for r in self.results if r.reading.basis]
+
+    @property
     def evidence(self) -> list[tuple[str, str]]:
         """The experiments its readings were tested on, each once, with the scale their runs are at."""
         return list(dict.fromkeys((r.reading.experiment, r.scale) for r in self.results if r.scale))
@@ -140,7 +145,9 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
                 "verdict": row.verdict.outcome.value, "reason": row.verdict.why,
                 "number": estimate.value if estimate else None, "ci_low": estimate.low if estimate else None,
                 "ci_high": estimate.high if estimate else None, "runs": estimate.runs if estimate else None,
-                "deciding": deciding.what if deciding else "",
+                "deciding": deciding.shown if deciding else "",
+                "at_equal_cost": "; ".join(f"{r.verdict.outcome.value} at equal {r.reading.basis}"
+                                           for r in row.at_equal_cost),
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
                 "robust": row.robust, **_across(row),
                 "scale": row.primary.scale,

@@ -24,8 +24,9 @@ COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted,
 def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """``spec.metric`` (mean and 95% interval over runs) against each cost of ``spec.costs`` (mean over
     runs; a time's median, which a slow first run does not move; log scale), one panel per cost; a
-    method's conditions (its particle counts, say) are joined by a line in order of cost, its other
-    swept variable ``spec.by`` (a scene) split into lines of their own."""
+    method's conditions (its particle counts, say) are joined by a line in order of cost with its
+    interval as a band (a single condition: a point with its interval), its other swept variable
+    ``spec.by`` (a scene) split into lines of their own."""
     metric, costs = spec["metric"], spec.get("costs", list(COSTS))
     missing = [c for c in (metric, *costs) if c not in records]
     if missing:
@@ -41,9 +42,15 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
         points = points[points["cost"] > 0]  # no work counted: a reference without a likelihood
         for (method, line), group in points.groupby(["method", "line"], sort=False):
             group = group.sort_values("cost")
-            interval = [group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]]
-            ax.errorbar(group["cost"], group["mean"], yerr=interval, **method_look(method).line(), markersize=5,
-                        capsize=2, elinewidth=0.8, label=f"{method_label(experiment, method)} {line}".strip())
+            look, label = method_look(method), f"{method_label(experiment, method)} {line}".strip()
+            if len(group) > 1:  # a line through its budgets, its interval a band
+                ax.plot(group["cost"], group["mean"], **look.line(), markersize=4, label=label)
+                ax.fill_between(group["cost"], group["ci_low"], group["ci_high"], color=look.colour, alpha=0.15,
+                                linewidth=0)
+            else:  # one budget: a point and its interval
+                interval = [group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]]
+                ax.errorbar(group["cost"], group["mean"], yerr=interval, **look.line(), markersize=6, capsize=3,
+                            elinewidth=0.9, label=label)
         ax.set_xscale("log")
         ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
         ax.xaxis.set_minor_formatter(NullFormatter())

@@ -45,7 +45,11 @@ class Look:
 METHODS = {  # config key -> look; every method of conf/experiment/*.yaml
     # plain particle filters
     "PF": Look(BLUE, "-", "o"),
-    "PF-N": Look(BLUE, ":", "<"),  # the bootstrap PF over an N sweep, for error against cost (hspf, gps_qmcpf)
+    # the baselines over an N sweep, for error against cost (hspf, gps_qmcpf, fusion_pf)
+    "PF-N": Look(BLUE, ":", "<"),
+    "NQMCPF-N": Look(SKY, ":", "<"),
+    "TR-SQMC-N": Look(GREEN, ":", "<"),
+    "colour-only-N": Look(BLUE, ":", "s"),
     "MIPF": Look(BLUE, "-", "s"),
     "color-only PF": Look(BLUE, "--", "s"),
     "colour-sigma-0.1": Look(SKY, "--", "s"),
