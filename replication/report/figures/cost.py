@@ -1,6 +1,7 @@
 """Error against cost: a method below another's line at equal cost is better at that budget, whatever the
 particle counts (the SMC literature's comparison at equal work: Gerber and Chopin, JRSS B 2015)."""
 
+import math
 import textwrap
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
-from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from replication.condition import label_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
@@ -26,7 +27,7 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
     runs; a time's median, which a slow first run does not move; log scale), one panel per cost; a
     method's conditions (its particle counts, say) are joined by a line in order of cost with its
     interval as a band (a single condition: a point with its interval), its other swept variable
-    ``spec.by`` (a scene) split into lines of their own."""
+    ``spec.by`` (a scene) split into lines of their own; ``spec.log_y`` puts the metric on a log scale."""
     metric, costs = spec["metric"], spec.get("costs", list(COSTS))
     missing = [c for c in (metric, *costs) if c not in records]
     if missing:
@@ -53,13 +54,22 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
                             elinewidth=0.9, label=label)
         ax.set_xscale("log")
         ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.xaxis.set_minor_formatter(FuncFormatter(_two_and_five))
+        if spec.get("log_y"):  # a method far off the others (a chain that loses the balls) on one axis
+            ax.set_yscale("log")
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
         ax.set_xlabel(f"{axis_label(cost)} ({statistic} over runs, log scale)")
         ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(textwrap.fill(spec.get("title", ""), 120), fontsize=9)
     axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     return save(fig, path, dpi=120)
+
+
+def _two_and_five(value: float, _) -> str:
+    """A minor tick's label on a log axis, at 2 and 5 times a power of ten only (the others stay unlabelled)."""
+    lead = value / 10 ** math.floor(math.log10(value))
+    return f"{value:g}" if round(lead, 6) in (2.0, 5.0) else ""
 
 
 def _swept(summary: pd.DataFrame) -> list[str]:
