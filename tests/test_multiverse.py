@@ -11,7 +11,7 @@ from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
 from replication.evidence.claims import Check, Claim, Reading, Result, load_papers
-from replication.evidence.multiverse import READING, Case, Robustness
+from replication.evidence.multiverse import BASIS, EQUAL_N, READING, Case, Robustness, basis_of
 from replication.evidence.schema import Summary
 from replication.evidence.statistics import Estimate
 from replication.report.pages.multiverse import write_multiverse_report
@@ -61,13 +61,13 @@ def test_an_override_touches_only_paths_that_exist():
     assert config["methods"]["ISM"]["bests"] == "stored"  # the original is left as it was
 
 
-def _multiverse_cfg(tmp_path, choices: dict, design_spec="full"):
+def _multiverse_cfg(tmp_path, choices: dict, design_spec="full", experiments=("hspf_ungm",)):
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=["experiment=hspf_ungm", "scale=quick", f"store={tmp_path}/store",
                                            f"reports={tmp_path}/reports", "progress=false"])
     top = OmegaConf.to_container(cfg, resolve=True)
     top["experiment"] = {"name": "hspf_test_readings", "paper": "hspf", "title": "test",
-                         "multiverse": {"experiments": ["hspf_ungm"], "runs": {"paper": 5, "quick": 5},
+                         "multiverse": {"experiments": list(experiments), "runs": {"paper": 5, "quick": 5},
                                         "design": design_spec},
                          "choices": choices}
     return OmegaConf.create(top)
@@ -90,7 +90,7 @@ def test_the_default_must_be_the_config_as_it_stands_and_every_path_must_exist(t
 
 
 def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_universe(tmp_path):
-    cfg = _multiverse_cfg(tmp_path, HMS)
+    cfg = _multiverse_cfg(tmp_path, HMS, experiments=("hspf_ungm", "hspf_ungm_cost"))
     multiverse = load(cfg)
     assert [u.name for u in multiverse.universes] == ["default", "hms=larger"]
     default = {r.run_id for r in multiverse.runs["default", "hspf_ungm"]}
@@ -103,15 +103,22 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
     # PF and the grid are the same in both universes (their first 5 runs), HSPF differs
     assert {i.split("__")[0] for i in larger - default} == {"HSPF"} and len(default & larger) == 10
     assert len(multiverse.runs_of("hspf_ungm")) == 65
-    store = Store(tmp_path / "store", "hspf_ungm")
-    assert execute(multiverse.runs_of("hspf_ungm"), store, n_jobs=1, backend="threading", progress=False) == 65
+    for name in multiverse.experiments:
+        runs = multiverse.runs_of(name)
+        assert execute(runs, Store(tmp_path / "store", name), n_jobs=1, backend="threading", progress=False) \
+            == len(runs)
     page = write_multiverse_report(cfg, multiverse)
     claim = Summary.read(page.parent / "summary.json").multiverse["hspf.ungm"]
     readings = [r.name for p in load_papers() for c in p.claims if c.id == "hspf.ungm" for r in c.readings
-                if r.experiment in multiverse.experiments]  # not the equal-cost ones, on hspf_ungm_cost
+                if r.experiment in multiverse.experiments]  # the equal-cost ones on hspf_ungm_cost included
     assert 0 < len(readings) and claim.cases == 2 * len(readings)  # every universe with every reading it runs
     cases = pd.read_csv(page.parent / "cases.csv")
     assert {("hms", "paper"), ("hms", "larger")} <= set(zip(["hms"] * len(cases), cases["hms"]))
+    # equal cost is a named choice: each universe scored at equal N, equal evaluations and equal time
+    ours = cases[cases["claim_id"] == "hspf.ungm"]
+    assert set(zip(ours["universe"], ours[BASIS])) == {
+        (u, b) for u in ("default", "hms=larger")
+        for b in (EQUAL_N, "equal likelihood evaluations per step", "equal time per step (ms)")}
     assert (page.parent / "readings.png").exists() and (page.parent / "cases.csv").exists()
 
 
@@ -165,6 +172,29 @@ def test_a_choice_with_a_real_effect_that_moves_the_verdict_makes_it_depend_on_t
     assert "moved by x=b (+1" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
     # between two inconclusive cases the one with more checks holding is closer
     assert Robustness(CLAIM, cases[2:]).best_case.universe == "y=b'"
+
+
+def test_equal_cost_is_a_named_choice_of_its_own_twinned_with_its_universe_at_equal_n():
+    """Scoring at equal evaluations or equal time is an alternative of BASIS, each case compared with its own
+    universe's default reading at equal N; it is not counted again among the scoring readings."""
+    def scored(universe, x, basis, reading, outcome):
+        case = _case(universe, {"x": x}, outcome, reading=reading)
+        return Case(case.universe, ((("x", x)), (BASIS, basis), (READING, reading)), case.result)
+
+    cases = (scored("default", "a", EQUAL_N, "r1", Outcome.REPRODUCED),
+             scored("default", "a", EQUAL_N, "r2", Outcome.REPRODUCED),
+             scored("default", "a", "equal time per step (ms)", "r-time", Outcome.NOT_REPRODUCED),
+             scored("x=b", "b", EQUAL_N, "r1", Outcome.INCONCLUSIVE),
+             scored("x=b", "b", "equal time per step (ms)", "r-time", Outcome.REPRODUCED))
+    robustness = Robustness(CLAIM, cases)
+    effects = {(e.choice, e.alternative): e for e in robustness.effects}
+    assert set(effects) == {("x", "b"), (BASIS, "equal time per step (ms)"), (READING, "r2")}
+    at_time = effects[BASIS, "equal time per step (ms)"]
+    # default: reproduced vs not reproduced (a conflict); x=b: its own r1 (inconclusive) vs reproduced (none)
+    assert (at_time.flips, at_time.compared) == (1, 2) and at_time.moves
+    assert "compared at equal time per step (ms) (1 of 2 decisive verdicts conflict)" in robustness.flipped_by
+    assert basis_of(Reading("r", "e", {"test": "order"})) == EQUAL_N
+    assert basis_of(Reading("r", "e", {"test": "equal_cost", "cost": "ms_per_step"})) == "equal time per step (ms)"
 
 
 def test_every_multiverse_config_loads_with_its_defaults_equal_to_the_experiments(tmp_path):

@@ -17,17 +17,27 @@ from replication.evidence.verdict import Outcome, Verdict
 # how close a verdict is to the claim holding: the best case for the paper has the highest
 CLOSENESS = {Outcome.REPRODUCED: 3, Outcome.INCONCLUSIVE: 2, Outcome.NOT_REPRODUCED: 1, Outcome.NOT_TESTABLE: 0}
 READING = "reading"  # the scoring readings, a choice of their own beside the run-level ones
+BASIS = "compared at"  # what the methods are given in common: equal N (the papers'), or a budget of work or time
+EQUAL_N = "equal N"
+SCORING = (READING, BASIS)  # choices made in scoring the runs, not in running them
+
+
+def basis_of(reading) -> str:
+    """A scoring reading's alternative of :data:`BASIS`."""
+    return f"equal {reading.basis}" if reading.basis else EQUAL_N
 SHOWN_FLIPS = 4  # in a claim's one-line summary; its page lists every case
 
 
 def _alternative(choice: str, alternative: str) -> str:
-    return f"scored by '{alternative}'" if choice == READING else f"{choice}={alternative}"
+    if choice == READING:
+        return f"scored by '{alternative}'"
+    return f"compared at {alternative}" if choice == BASIS else f"{choice}={alternative}"
 
 
 @dataclass(frozen=True)
 class Case:
     universe: str
-    picks: tuple[tuple[str, str], ...]  # (choice, alternative) of the universe, then ("reading", its name)
+    picks: tuple[tuple[str, str], ...]  # (choice, alternative) of the universe, then BASIS's and READING's
     result: Result
 
     @property
@@ -75,22 +85,32 @@ class Robustness:
         twin (the case that differs only in that choice, set to its default; where a design has no twins,
         Sobol points, the default case), and how many of its cases' verdicts differ from the twin's.  A
         scoring reading, and a statistic with no per-run values (a published cell, a ranking), count only
-        conflicting decisive verdicts (reproduced against not reproduced)."""
+        conflicting decisive verdicts (reproduced against not reproduced).  A reading at equal cost is an
+        alternative of :data:`BASIS` (its twin: the same universe scored by the default reading), not of
+        :data:`READING`, whose alternatives are the readings at equal N."""
         testable = self.testable
         cases = {c.picks: c for c in testable}
         default_picks = dict(self.default.picks)
+
+        def twin(case: Case, choice: str) -> Case | None:
+            swapped = {choice, READING} if choice == BASIS else {choice}  # another basis is another reading
+            return cases.get(tuple((ch, default_picks[ch] if ch in swapped else a) for ch, a in case.picks))
+
         found = []
         for choice, alternative in dict.fromkeys(p for c in testable for p in c.picks):
             if default_picks.get(choice) == alternative:
                 continue
             under = [c for c in testable if (choice, alternative) in c.picks]
-            twins = [(c, cases.get(tuple((ch, default_picks[ch] if ch == choice else a) for ch, a in c.picks)))
-                     for c in under]
+            if choice == READING:  # a reading at equal cost counts under BASIS
+                under = [c for c in under if dict(c.picks).get(BASIS) == default_picks.get(BASIS)]
+            if not under:
+                continue
+            twins = [(c, twin(c, choice)) for c in under]
             pairs = [(c, t) for c, t in twins if t is not None]
             compared = "twin" if pairs else "default"
             pairs = pairs or [(c, self.default) for c in under]
-            effect, p = (None, math.nan) if choice == READING else self._paired(pairs)
-            if choice == READING or effect is None:
+            effect, p = (None, math.nan) if choice in SCORING else self._paired(pairs)
+            if choice in SCORING or effect is None:
                 compared = "readings"
                 flips = sum({c.verdict.outcome, t.verdict.outcome} == DECISIVE for c, t in pairs)
             else:

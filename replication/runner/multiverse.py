@@ -211,11 +211,12 @@ def load(cfg: DictConfig) -> Multiverse:
     unknown = sorted(set(experiments) - set(experiment_names()))
     if unknown:
         raise ConfigError(f"experiment.multiverse.experiments: no experiment {unknown[0]!r}")
+    named = OmegaConf.to_container(exp.multiverse, resolve=True).get("experiments") or ()
+    named = {e for listed in (named.values() if isinstance(named, dict) else [named]) for e in listed}
     bases = {name: _experiment(name) for name in experiments}
+    _check_choices(choices, {**{name: _experiment(name) for name in sorted(named - set(bases))}, **bases},
+                   cfg.scale)
     universes = design(choices, spec.get("design", "full"), int(cfg.base_seed))
-    varied = {choice for u in universes for choice, alternative in u.picks
-              if alternative != next(c.default.name for c in choices if c.name == choice)}
-    _check_choices(choices, bases, cfg.scale, varied)
     top = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items() if k != "experiment"}
     runs, configs, skipped = {}, {}, {}
     for universe in universes:
@@ -244,18 +245,18 @@ def _experiment(name: str) -> dict:
     return OmegaConf.to_container(compose("config", overrides=[f"experiment={name}"]).experiment, resolve=True)
 
 
-def _check_choices(choices: tuple[Choice, ...], bases: dict[str, dict], scale: str, varied: set[str]) -> None:
-    """Every alternative's every path of a choice the design varies exists in some base experiment, and
-    the default's values are the configs' own wherever they exist (so the default universe is the
-    experiments as they stand).  A choice the design leaves at its default may set keys of experiments
-    this scale leaves out (the quick scale's smaller multiverse)."""
+def _check_choices(choices: tuple[Choice, ...], bases: dict[str, dict], scale: str) -> None:
+    """Every alternative's every path exists in some experiment the multiverse names (at any scale: the
+    quick scale's smaller multiverse may leave out experiments whose keys a choice also sets), and the
+    default's values are the configs' own wherever they exist (so the default universe is the experiments
+    as they stand)."""
     for choice in choices:
         for alternative in choice.alternatives:
             for path, value in alternative.values.items():
                 places = [(name, container[key]) for name, base in bases.items()
                           for container, key in matches(base, path)]
                 where = f"experiment.choices.{choice.name}.alternatives.{alternative.name}.set.{path}"
-                if not places and choice.name in varied:
+                if not places:
                     raise ConfigError(f"{where}: no such key in {', '.join(bases)} (write the default there first)")
                 if alternative is choice.default:
                     differing = [name for name, found in places if at_scale(found, scale) != at_scale(value, scale)]
