@@ -19,7 +19,7 @@ from joblib import Parallel, delayed
 from replication.cli import check_request
 from replication.errors import ConfigError
 from replication.runner.config import expand
-from replication.runner.execute import TIMING_COLUMNS, execute, parallel_backend
+from replication.runner.execute import TIMING_COLUMNS, execute, parallel_backend, schedule
 from replication.runner.store import Store
 from replication.runner.validate import prepare
 
@@ -125,6 +125,22 @@ NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="re
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 @NEEDS_PROC
+def test_runs_start_scene_by_scene_and_repetition_by_repetition(make_cfg):
+    """The schedule keeps every run, puts one repetition's methods and particle counts together inside each
+    scene (the runs a comparison pairs are computed close in time), and spreads each condition's runs over
+    its scene's whole span."""
+    runs = expand(make_cfg("ism_pf_particles", "scale=quick"))
+    order = schedule(runs)
+    assert sorted(r.run_id for r in order) == sorted(r.run_id for r in runs)
+    keys = [(str(r.data_condition), r.repetition) for r in order]
+    blocks = list(dict.fromkeys(keys))
+    assert keys == sorted(keys, key=blocks.index)  # each (scene, repetition) one contiguous block
+    assert [b[1] for b in blocks] == [0, 1, 2] * 2 and len({b[0] for b in blocks}) == 2
+    scene = [r for r in order if str(r.data_condition) == blocks[0][0]]
+    positions = [i for i, r in enumerate(scene) if r.method == "PF" and str(r.condition).endswith("N=1100")]
+    assert len(positions) == 3 and positions[-1] - positions[0] > len(scene) / 2  # spread over the scene's span
+
+
 def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(make_cfg, tmp_path):
     """Ctrl-C at one random moment, SIGTERM at another, SIGKILL at a third, resume: the table of an
     uninterrupted run.  SIGTERM is handled as Ctrl-C, with status 143 (128 + 15), and leaves no process.

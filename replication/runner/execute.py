@@ -207,6 +207,19 @@ def _one_line(error: BaseException) -> str:
     return " ".join(str(error).split()) or error.__class__.__name__
 
 
+def schedule(runs: list[Run]) -> list[Run]:
+    """The order runs start in: data condition by data condition (a scene, in the order they come), and in
+    each, repetition by repetition, every method and particle count of one repetition together.  So the runs
+    that will be compared (paired on the same data and repetition) are computed close in time, and each
+    method's and N's runs spread over the whole span of their scene: a change of the machine's load while
+    an experiment runs falls on every condition alike, not on the conditions that happen to run then (a
+    time per step compared across an N sweep, the equal-time readings); and one repetition's video, drawn
+    once per run when each repetition has its own, serves its methods from the scene cache.  The order
+    changes no record: each run's numbers depend only on its own seed."""
+    scenes = {data: i for i, data in enumerate(dict.fromkeys(str(run.data_condition) for run in runs))}
+    return sorted(runs, key=lambda run: (scenes[str(run.data_condition)], run.repetition))
+
+
 def execute(
     runs: list[Run],
     store: Store,
@@ -225,6 +238,7 @@ def execute(
     that arrived before it stored.
     """
     pending, corrupt = store.pending(runs)
+    pending = schedule(pending)
     if corrupt:
         print(f"re-running {len(corrupt)} corrupt result file(s): {summarise(corrupt)}", file=sys.stderr)
     if not pending:
