@@ -2,7 +2,7 @@
 # make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
 # make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
 # make report      redraw every report from the stored runs, running nothing
-# make benchmark   time the SMC core on this machine (reports/benchmark/)
+# make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
@@ -66,6 +66,7 @@ readings: setup
 
 benchmark: setup
 	$(BIN)/python benchmarks/benchmark.py
+	$(BIN)/python benchmarks/peers.py
 
 report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)

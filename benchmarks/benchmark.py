@@ -6,17 +6,17 @@
    ``cv2.calcHist`` (unweighted: cheaper than the kernel histogram it stands
    for), the vectorised numpy path the kernel replaced, and a per-particle
    loop of the same kernel histogram.
-2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6, beside
-   the same bootstrap PF in Chopin's ``particles`` when it is installed
-   (``pip install particles``; not a dependency of the project).
+2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6 (against
+   ``particles``, Stone Soup and filterpy, each in its own venv:
+   ``benchmarks/peers.py``, the second half of ``make benchmark``).
 3. Rendering a 480 x 410 synthetic frame with 36 targets.
 4. BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second
    against the paper's 5.52, a profile of where the time goes, and its time
    per frame against the number of targets M (the paper claims O(M)).
-5. The three ratios of issue 18, each against its peer measured in this run:
-   the likelihood against the calcHist loop at N = 1000 (>= 10), BIS-PF
-   against the paper's frame rate (>= 10), and the PF step at N = 100,000
-   against ``particles`` (<= 1).
+5. Two ratios of issue 18, each against its peer measured in this run: the
+   likelihood against the calcHist loop at N = 1000 (>= 10) and BIS-PF
+   against the paper's frame rate (>= 10); the PF step's against its peers
+   are ``peers.py``'s.
 
 BLAS runs one thread, as in the experiments' workers (joblib's loky limits
 each worker to cpu_count // n_jobs threads: one on this two-core machine);
@@ -42,6 +42,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+from markupsafe import Markup  # noqa: E402
 
 from replication.filters import PointMassFilter, bootstrap  # noqa: E402
 from replication.models import UNGM  # noqa: E402
@@ -58,7 +59,6 @@ BINS = (8, 8, 4)
 OURS = "compiled kernel, all 40x40 pixels (the likelihood)"
 CALCHIST = "per-particle cv2.calcHist loop (no kernel)"
 PF_STEP = "bootstrap PF step (UNGM)"
-PARTICLES = "particles (Chopin): bootstrap PF step (UNGM)"
 PAPER_FPS = 5.52  # bis_pf, Table 1: BIS-PF on the 36 balls, 1.4 GHz Pentium 4
 
 
@@ -119,41 +119,10 @@ def _calchist(hsv, box):
     return cv2.calcHist([roi], [0, 1, 2], None, list(BINS), [0, 180, 0, 256, 0, 256])
 
 
-def particles_peer(model: UNGM, observations):
-    """The same bootstrap PF (systematic resampling every step, no history kept) in Chopin's
-    ``particles``, as a function of N; None when it is not installed."""
-    try:
-        import particles
-        from particles import distributions as dists
-        from particles import state_space_models as ssm
-    except ImportError:
-        return None
-
-    class ParticlesUNGM(ssm.StateSpaceModel):  # gps_qmcpf eqs (11)-(12), particles' t = ours - 1
-        default_params = {"Q": model.Q, "R": model.R, "x0": model.x0, "P0": model.P0}
-
-        def PX0(self):
-            return dists.Normal(loc=self.x0, scale=np.sqrt(self.P0))
-
-        def PX(self, t, xp):
-            return dists.Normal(loc=0.5 * xp + 25.0 * xp / (1.0 + xp**2) + 8.0 * np.cos(1.2 * t), scale=np.sqrt(self.Q))
-
-        def PY(self, t, xp, x):
-            return dists.Normal(loc=x**2 / 20.0, scale=np.sqrt(self.R))
-
-    fk = ssm.Bootstrap(ssm=ParticlesUNGM(), data=list(observations))
-
-    def run(n):
-        particles.SMC(fk=fk, N=n, resampling="systematic", ESSrmin=1.0, collect=None, store_history=False).run()
-
-    return run
-
-
 def smc_core() -> pd.DataFrame:
     rng = np.random.default_rng(0)
     model = UNGM(steps=20)
     observations = model.simulate(rng)[1]
-    peer = particles_peer(model, observations)
     rows = []
     for n in (100, 1_000, 10_000, 100_000, 1_000_000):
         weights = rng.dirichlet(np.ones(n))
@@ -163,9 +132,6 @@ def smc_core() -> pd.DataFrame:
         pf.run(model, observations[:1], rng)  # the compiled resampler's first call
         seconds = best_of(lambda: pf.run(model, observations, rng), repeats=5) / model.steps
         rows.append({"what": PF_STEP, "N": n, "us_per_call": 1e6 * seconds})
-        if peer is not None:
-            seconds = best_of(lambda: peer(n), repeats=5) / model.steps
-            rows.append({"what": PARTICLES, "N": n, "us_per_call": 1e6 * seconds})
     for points in (801, 1601, 3201):
         seconds = best_of(lambda: PointMassFilter(points).run(model, observations), repeats=3) / model.steps
         rows.append({"what": "point-mass filter step (UNGM)", "N": points, "us_per_call": 1e6 * seconds})
@@ -258,10 +224,9 @@ def _loglog(table, x, y, group, path, ylabel):
     plt.close(fig)
 
 
-def ratios(likelihood: pd.DataFrame, core: pd.DataFrame, bis_speed: pd.DataFrame) -> pd.DataFrame:
-    """Issue 18's three ratios, each against its peer measured in this run."""
+def ratios(likelihood: pd.DataFrame, bis_speed: pd.DataFrame) -> pd.DataFrame:
+    """Issue 18's ratios of the likelihood and BIS-PF, each against its peer measured in this run."""
     at = likelihood[likelihood["N"] == 1000].set_index("method")["seconds"]
-    step = core[core["N"] == 100_000].set_index("what")["us_per_call"]
     fps = float(bis_speed["frames_per_s"].iloc[0])
     rows = [
         {"ratio": "colour likelihood, N = 1000, every pixel of 40x40 kernel-weighted: speed / per-particle cv2.calcHist loop",
@@ -271,23 +236,14 @@ def ratios(likelihood: pd.DataFrame, core: pd.DataFrame, bis_speed: pd.DataFrame
          "value": fps / PAPER_FPS, "target": ">= 10", "met": fps / PAPER_FPS >= 10,
          "ours": f"{fps:.1f} frames/s", "peer": f"{PAPER_FPS} frames/s (bis_pf Table 1, 1.4 GHz Pentium 4)"},
     ]
-    if PARTICLES in step:
-        value = step[PF_STEP] / step[PARTICLES]
-        rows.append({"ratio": "bootstrap PF step, UNGM, N = 100,000: time / particles' time", "value": value,
-                     "target": "<= 1", "met": value <= 1, "ours": f"{step[PF_STEP] / 1e3:.2f} ms",
-                     "peer": f"{step[PARTICLES] / 1e3:.2f} ms (particles, this run)"})
-    else:
-        rows.append({"ratio": "bootstrap PF step, UNGM, N = 100,000: time / particles' time", "value": np.nan,
-                     "target": "<= 1", "met": None, "ours": f"{step[PF_STEP] / 1e3:.2f} ms",
-                     "peer": "particles not importable here (its 0.4 needs numpy < 2; README: 0.61 in one run)"})
     return pd.DataFrame(rows)
 
 
 def throughput_plot(likelihood: pd.DataFrame, core: pd.DataFrame, path) -> None:
-    """Particles per second against N: the likelihood and its peers, the PF step and particles'."""
+    """Particles per second against N: the likelihood and its peers, and the PF step (its peers: peers.py)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     per_particle = likelihood[~likelihood["method"].str.startswith("per frame")]
-    steps = core[core["what"].isin([PF_STEP, PARTICLES])].assign(particles_per_s=lambda t: t["N"] / (t["us_per_call"] / 1e6))
+    steps = core[core["what"] == PF_STEP].assign(particles_per_s=lambda t: t["N"] / (t["us_per_call"] / 1e6))
     for ax, table, group, title in ((axes[0], per_particle, "method", "colour likelihood (40x40 boxes)"),
                                     (axes[1], steps, "what", "bootstrap PF step (UNGM)")):
         for name, rows in table.groupby(group, sort=False):
@@ -323,7 +279,7 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
     bis_speed, bis_profile, bis_scaling = bis_pf_36()
-    summary = ratios(likelihood, core, bis_speed)
+    summary = ratios(likelihood, bis_speed)
     for name, table in (("likelihood", likelihood), ("smc_core", core), ("rendering", render_cost),
                         ("bis_pf_speed", bis_speed), ("bis_pf_profile", bis_profile), ("bis_pf_scaling", bis_scaling),
                         ("ratios", summary)):
@@ -348,6 +304,12 @@ def main() -> None:
             sections=[
                 {"title": "Issue 18's ratios, each against its peer measured in this run",
                  "figure": None, "table": html_table(summary.round(2))},
+                {"title": "The PF step and the resamplers against particles, Stone Soup and filterpy",
+                 "figure": None,
+                 "table": Markup('<p><a href="peers.html">each peer in its own venv, timed in turn with ours</a></p>')
+                 if (out / "peers.html").exists() else
+                 Markup("<p>Not measured on this machine yet: <code>make benchmark</code> installs the peers and times "
+                        "them (<code>benchmarks/peers.py</code>).</p>")},
                 {"title": "Throughput against N: ours and the peers (particles per second)",
                  "figure": "throughput.png", "table": ""},
                 {"title": "Colour likelihood throughput (480x410 frame, 40x40 boxes, 8x8x4 bins)",

@@ -1,0 +1,407 @@
+"""``python benchmarks/peers.py`` (part of ``make benchmark``): our bootstrap PF step and resamplers
+against peer libraries, each installed in its own venv.
+
+What is compared, on the UNGM (gps_qmcpf eqs (11)-(12), T = 20 observations simulated here):
+
+* ours, ``bootstrap(N, "systematic", 1.0)`` (systematic resampling at every step, no history),
+  against Chopin's ``particles`` (the same bootstrap PF, and SQMC: another algorithm for the same
+  filtering means) and Stone Soup (``ParticlePredictor`` + ``ParticleUpdater`` +
+  ``SystematicResampler``): seconds per step;
+* our four resamplers against filterpy's (``filterpy.monte_carlo``) on the same weights: seconds
+  per call.
+
+How: the peer scripts of ``benchmarks/peers/`` run in venvs made once under ``.peers/<peer>/`` from
+the pinned ``benchmarks/peers/<peer>.txt`` (remade when that file changes); a peer that cannot be
+installed or run is reported in one line and skipped.  For N = 10^2 .. 10^6, ours (in this process)
+and the peer (one subprocess call, timing itself: no start-up or imports) run in turn, A B A B, for
+``--rounds`` rounds; each side first runs untimed at that N (two steps of the filter, or one
+resampling), and both have the same glibc allocator thresholds (``retain_freed_memory``) and one
+BLAS thread.  Reported per N: the median and range over rounds of t_ours / t_peer.
+
+Agreement, checked before the times are compared: for a filter, the distance is the mean over
+steps of |mean over rounds of ours' filtering mean - the same of the peer's|, and the bound 4 times
+the mean over steps of its standard error from the spread of the rounds; for a resampler (whose
+estimate is the mean of N W_i over the indices drawn, expected N sum W_i^2), the distance is
+|mean over rounds of ours - the same of the peer's|, the bound 4 times its standard error under
+multinomial draws (which residual and stratified draws do not exceed).  The distance of each side
+from the exact value (the grid filter, ``PointMassFilter``; N sum W_i^2) is shown beside.  A peer
+beyond its bound is reported as disagreeing and its times are flagged.
+
+The bound of a step, a floor under any implementation's time: max(8 N (4 d + 4) bytes / the copy
+bandwidth, the time of drawing N standard normals), d = 1 (four passes over the N d-vectors of
+states: propose, weigh, gather, mean; and four N-vectors of 8 bytes: log-weights, weights,
+cumulative weights, ancestors).  The bandwidth is numpy's best copy of 2 x 10^8 bytes, counting
+the bytes read and written.
+
+Writes ``reports/benchmark/peers.csv``, ``peers_ratios.csv``, ``peers.png`` and ``peers.html``.
+A script, not a test: timings depend on the machine and its load.
+"""
+
+import os
+
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads BLAS
+    os.environ.setdefault(_variable, "1")
+
+import argparse  # noqa: E402
+import hashlib  # noqa: E402
+import json  # noqa: E402
+import platform  # noqa: E402
+import shutil  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from replication.filters import PointMassFilter, bootstrap  # noqa: E402
+from replication.models import UNGM  # noqa: E402
+from replication.paths import resolve  # noqa: E402
+from replication.report.pages.render import html_table, render  # noqa: E402
+from replication.runner.memory import MMAP_THRESHOLD, TRIM_THRESHOLD, retain_freed_memory  # noqa: E402
+from replication.smc.resampling import RESAMPLERS  # noqa: E402
+
+SCRIPTS = Path(__file__).resolve().parent / "peers"
+VENVS = resolve(".peers")
+PEERS = {"particles": "particles_ungm.py", "stonesoup": "stonesoup_ungm.py",
+         "filterpy": "filterpy_resampling.py"}
+RESAMPLING_PEERS = {"filterpy"}  # the others filter the UNGM
+SIZES = (10**2, 10**3, 10**4, 10**5, 10**6)
+TABLE_SIZES = (10**3, 10**4, 10**5, 10**6)
+STEPS = 20
+BOUND_SIGMAS = 4.0
+PEER_ENV = {**os.environ, "MALLOC_MMAP_THRESHOLD_": str(MMAP_THRESHOLD),
+            "MALLOC_TRIM_THRESHOLD_": str(TRIM_THRESHOLD)}
+
+
+class PeerFailed(Exception):
+    """A peer that could not be installed or run: its one-line reason."""
+
+
+def last_line(text: str) -> str:
+    return next((line.strip() for line in reversed(text.splitlines()) if line.strip()), "no output")
+
+
+def peer_python(peer: str) -> Path:
+    """The python of the peer's venv, made with the project's base python from its pinned
+    requirements, or remade when they (or that python) changed."""
+    requirements, venv = SCRIPTS / f"{peer}.txt", VENVS / peer
+    digest = hashlib.sha256(requirements.read_bytes() + sys._base_executable.encode()).hexdigest()
+    stamp, python = venv / "requirements.sha256", venv / "bin" / "python"
+    if stamp.exists() and stamp.read_text() == digest:
+        print(f"{peer}: venv {venv} up to date")
+        return python
+    print(f"{peer}: installing benchmarks/peers/{requirements.name} into {venv} ...", flush=True)
+    shutil.rmtree(venv, ignore_errors=True)
+    pip = [str(python), "-m", "pip", "install", "--quiet", "--disable-pip-version-check", "-r",
+           str(requirements)]
+    for command in ([sys._base_executable, "-m", "venv", str(venv)], pip):
+        done = subprocess.run(command, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            raise PeerFailed(f"could not be installed ({last_line(done.stderr)})")
+    stamp.write_text(digest)
+    return python
+
+
+def installed_peers() -> tuple[dict[str, Path], dict[str, str]]:
+    """The python of each peer that installs, and why each other one is skipped."""
+    pythons, skipped = {}, {}
+    for peer in PEERS:
+        try:
+            pythons[peer] = peer_python(peer)
+        except PeerFailed as failure:
+            skipped[peer] = str(failure)
+            print(f"{peer}: {failure}; skipped")
+    return pythons, skipped
+
+
+@dataclass
+class Inputs:
+    """What ours and a peer are given at one N: the UNGM, its observations and their exact filtering
+    means, the weights to resample, and the files in ``folder`` a peer script reads."""
+
+    model: UNGM
+    observations: np.ndarray
+    exact_means: np.ndarray
+    weights: np.ndarray
+    folder: Path
+
+    def __post_init__(self):
+        np.save(self.folder / "observations.npy", self.observations)
+        np.save(self.folder / "weights.npy", self.weights)
+
+    @property
+    def n(self) -> int:
+        return len(self.weights)
+
+    def file(self, resampling: bool) -> Path:
+        return self.folder / ("weights.npy" if resampling else "observations.npy")
+
+    def exact(self, resampling: bool) -> tuple[np.ndarray, float | None]:
+        """The exact values of the estimates and, for a resampler, one estimate's standard error: the
+        filtering means; or N sum W_i^2, the expected mean of N W_i over N indices drawn by an unbiased
+        scheme, and its standard error under multinomial draws."""
+        if not resampling:
+            return self.exact_means, None
+        n, w = self.n, self.weights
+        mean = n * np.sum(w**2)
+        return np.array([mean]), np.sqrt((np.sum(w * (n * w) ** 2) - mean**2) / n)
+
+
+def run_peer(python: Path, peer: str, inputs: Inputs, seed: int) -> dict:
+    """One call of the peer's script: {"versions", "results": [{"what", "N", "seconds", "estimates"}]}."""
+    n, model, out = inputs.n, inputs.model, inputs.folder / "out.json"
+    command = [str(python), str(SCRIPTS / PEERS[peer]), "--data", str(inputs.file(peer in RESAMPLING_PEERS)),
+               "--n", str(n), "--seed", str(seed), "--out", str(out),
+               "--model", json.dumps({"Q": model.Q, "R": model.R, "x0": model.x0, "P0": model.P0})]
+    done = subprocess.run(command, capture_output=True, text=True, env=PEER_ENV, timeout=3600, check=False)
+    if done.returncode != 0:
+        raise PeerFailed(f"failed at N = {n} ({last_line(done.stderr)})")
+    return json.loads(out.read_text())
+
+
+def ours_filter(inputs: Inputs, seed: int) -> tuple[float, np.ndarray]:
+    """Seconds per step of our bootstrap PF (after an untimed two-step run at this N), its filtering means."""
+    rng = np.random.default_rng(seed)
+    pf = bootstrap(inputs.n, "systematic", 1.0)
+    pf.run(inputs.model, inputs.observations[:2], rng)
+    started = time.perf_counter()
+    means = pf.run(inputs.model, inputs.observations, rng).means
+    return (time.perf_counter() - started) / len(inputs.observations), means
+
+
+def ours_resampling(inputs: Inputs, seed: int) -> dict[str, tuple[float, list]]:
+    """Per scheme: seconds of one call (after an untimed one) and the mean of N W_i over the indices drawn."""
+    rng, weights, results = np.random.default_rng(seed), inputs.weights, {}
+    for scheme, resample in RESAMPLERS.items():
+        resample(weights, rng)
+        started = time.perf_counter()
+        indices = resample(weights, rng)
+        seconds = time.perf_counter() - started
+        results[f"resample ({scheme})"] = (seconds, [len(weights) * weights[indices].mean()])
+    return results
+
+
+def interleaved(peer: str, python: Path, inputs: Inputs, rounds: int) -> tuple[list, dict, dict]:
+    """``rounds`` rounds of ours then the peer: rows of times, per what the estimates of ours and of
+    the peer by round, and the peer's versions."""
+    resampling = peer in RESAMPLING_PEERS
+    rows, estimates = [], {}
+    for r in range(rounds):
+        ours = ours_resampling(inputs, r) if resampling else ours_filter(inputs, r)
+        output = run_peer(python, peer, inputs, r)
+        for result in output["results"]:
+            what = result["what"]
+            ours_seconds, ours_estimates = ours[what] if resampling else ours
+            rows.append({"peer": peer, "what": what, "N": inputs.n, "round": r,
+                         "seconds": result["seconds"][0], "ours_seconds": ours_seconds})
+            estimates.setdefault(what, ([], []))[0].append(ours_estimates)
+            estimates[what][1].append(result["estimates"][0])
+    return rows, estimates, output["versions"]
+
+
+def agreement(ours: np.ndarray, peer: np.ndarray, exact: np.ndarray, sd: float | None) -> dict:
+    """The distance of the peer's estimates from ours (rounds x steps) against its bound (from ``sd``,
+    one estimate's exact standard error, else from the spread over rounds); each side's distance
+    from exact."""
+    rounds = len(ours)
+    if sd is None:
+        standard_error = np.sqrt((ours.var(axis=0, ddof=1) + peer.var(axis=0, ddof=1)) / rounds)
+    else:
+        standard_error = np.full(ours.shape[1], np.sqrt(2 / rounds) * sd)
+    distance = float(np.mean(np.abs(ours.mean(axis=0) - peer.mean(axis=0))))
+    bound = BOUND_SIGMAS * float(np.mean(standard_error))
+    return {"agreement": "agrees" if distance <= bound else "disagrees", "distance": distance, "bound": bound,
+            "ours_from_exact": float(np.mean(np.abs(ours.mean(axis=0) - exact))),
+            "peer_from_exact": float(np.mean(np.abs(peer.mean(axis=0) - exact)))}
+
+
+def compare(sizes, rounds: int) -> tuple[pd.DataFrame, pd.DataFrame, dict, dict]:
+    """Every peer that runs against ours at each N: (times per round; agreement per peer, what and N;
+    the peers' versions; why a peer was skipped)."""
+    model = UNGM(steps=STEPS)
+    observations = model.simulate(np.random.default_rng(0))[1]
+    exact_means = PointMassFilter().run(model, observations).means
+    pythons, skipped = installed_peers()
+    rows, checks, versions = [], [], {}
+    with tempfile.TemporaryDirectory(prefix="peers-") as folder:
+        for n in sizes:
+            weights = np.random.default_rng(n).dirichlet(np.ones(n))
+            inputs = Inputs(model, observations, exact_means, weights, Path(folder))
+            for peer in [p for p in PEERS if p in pythons]:
+                print(f"timing N = {n}: ours against {peer}, {rounds} rounds", flush=True)
+                try:
+                    peer_rows, estimates, versions[peer] = interleaved(peer, pythons[peer], inputs, rounds)
+                except (PeerFailed, subprocess.TimeoutExpired) as failure:
+                    skipped[peer] = str(failure)
+                    del pythons[peer]
+                    print(f"{peer}: {failure}; skipped")
+                    continue
+                rows += peer_rows
+                exact, sd = inputs.exact(peer in RESAMPLING_PEERS)
+                for what, (ours_estimates, peer_estimates) in estimates.items():
+                    check = agreement(np.array(ours_estimates), np.array(peer_estimates), exact, sd)
+                    checks.append({"peer": peer, "what": what, "N": n, **check})
+                    ratio = np.median([row["ours_seconds"] / row["seconds"] for row in peer_rows
+                                       if row["what"] == what])
+                    print(f"  {what}: {check['agreement']} (distance {check['distance']:.3g}, bound "
+                          f"{check['bound']:.3g}); t_ours / t_peer median {ratio:.3g}")
+    times = pd.DataFrame(rows, columns=["peer", "what", "N", "round", "seconds", "ours_seconds"])
+    times["ratio"] = times["ours_seconds"] / times["seconds"]
+    checks = pd.DataFrame(checks, columns=["peer", "what", "N", "agreement", "distance", "bound",
+                                           "ours_from_exact", "peer_from_exact"])
+    return times, checks, versions, skipped
+
+
+def best_seconds(call, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        started = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - started)
+    return min(times)
+
+
+def copy_bandwidth(nbytes: int = 2 * 10**8, repeats: int = 5) -> float:
+    """Bytes per second of numpy's best copy of ``nbytes`` (the bytes read plus the bytes written)."""
+    source = np.ones(nbytes // 8)
+    target = np.empty_like(source)
+    return 2 * source.nbytes / best_seconds(lambda: np.copyto(target, source), repeats)
+
+
+def step_bound(sizes, bandwidth: float, d: int = 1) -> pd.DataFrame:
+    """Per N the two parts of a step's bound: the bytes it moves over the bandwidth, and drawing N
+    normals (best of 5, from a generator made once)."""
+    rng = np.random.default_rng()
+    return pd.DataFrame({"N": list(sizes),
+                         "bandwidth_bound_s": [8 * n * (4 * d + 4) / bandwidth for n in sizes],
+                         "normal_floor_s": [best_seconds(lambda n=n: rng.standard_normal(n), 5)
+                                            for n in sizes]})
+
+
+def ratio_table(times: pd.DataFrame, checks: pd.DataFrame, bound: pd.DataFrame) -> pd.DataFrame:
+    """Per peer, what and N: the median and range of t_ours / t_peer, the agreement, the medians of
+    both times and (for a filter step) the two parts of the bound."""
+    table = times.groupby(["peer", "what", "N"], sort=False).agg(
+        median_ratio=("ratio", "median"), min_ratio=("ratio", "min"), max_ratio=("ratio", "max"),
+        ours_median_s=("ours_seconds", "median"), peer_median_s=("seconds", "median")).reset_index()
+    table = table.merge(checks, on=["peer", "what", "N"]).merge(bound, on="N", how="left")
+    table.loc[table["what"].str.startswith("resample"), ["bandwidth_bound_s", "normal_floor_s"]] = np.nan
+    return table
+
+
+def figure(times: pd.DataFrame, table: pd.DataFrame, bound: pd.DataFrame, path: Path) -> None:
+    """Log-log against N, medians over rounds: seconds per step (ours, each filter peer, the bound's
+    two parts) and seconds per resampling (ours and filterpy, one colour per scheme); a disagreeing
+    peer is drawn with crosses and labelled so."""
+    fig, (steps, resampling) = plt.subplots(1, 2, figsize=(12, 4.5))
+    disagreeing = set(table.loc[table["agreement"] == "disagrees", ["peer", "what"]].itertuples(index=False))
+    medians = times.groupby(["peer", "what", "N"], sort=False)[["seconds", "ours_seconds"]].median()
+    medians = medians.reset_index()
+    palette = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = {f"resample ({scheme})": palette[i] for i, scheme in enumerate(RESAMPLERS)}
+    ours = medians.assign(what=medians["what"].where(medians["what"].isin(colours), "bootstrap PF step"))
+    for what, line in ours.groupby(["what", "N"])["ours_seconds"].median().groupby(level="what"):
+        (resampling if what in colours else steps).loglog(
+            line.index.get_level_values("N"), line.values, "o-", color=colours.get(what, "black"),
+            label=f"ours: {what}")
+    for (peer, what), line in medians.groupby(["peer", "what"], sort=False):
+        flagged = (peer, what) in disagreeing
+        (resampling if what in colours else steps).loglog(
+            line["N"], line["seconds"], "x--" if flagged else "s:", color=colours.get(what),
+            label=f"{peer}: {what}" + (" (DISAGREES)" if flagged else ""))
+    steps.loglog(bound["N"], bound["bandwidth_bound_s"], "-", color="grey", lw=0.8,
+                 label="bound: 8 N (4d + 4) bytes / copy bandwidth")
+    steps.loglog(bound["N"], bound["normal_floor_s"], "-.", color="grey", label="bound: drawing N normals")
+    for ax, title, unit in ((steps, "bootstrap PF step, UNGM", "step"),
+                            (resampling, "resampling alone", "call")):
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("N")
+        ax.set_ylabel(f"seconds per {unit} (median of rounds)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def ratio_cells(table: pd.DataFrame) -> pd.DataFrame:
+    """The ratios at N = 10^3 .. 10^6 as 'median [min, max]', one row per peer and what."""
+    shown = table[table["N"].isin(TABLE_SIZES)]
+    cells = [f"{m:.2f} [{lo:.2f}, {hi:.2f}]" + ("" if agrees == "agrees" else " DISAGREES")
+             for m, lo, hi, agrees in shown[["median_ratio", "min_ratio", "max_ratio", "agreement"]].values]
+    order = pd.MultiIndex.from_frame(shown[["peer", "what"]].drop_duplicates())
+    wide = shown.assign(cell=cells).pivot(index=["peer", "what"], columns="N", values="cell").reindex(order)
+    wide.columns = [f"N = {n:,}" for n in wide.columns]
+    return wide.reset_index()
+
+
+def significant(table: pd.DataFrame, digits: int = 3) -> pd.DataFrame:
+    """The floats as text to ``digits`` significant digits (microseconds and ratios alike), NaN as blank."""
+    return table.apply(lambda column: column.map(lambda v: "" if np.isnan(v) else f"{v:.{digits}g}")
+                       if column.dtype.kind == "f" else column)
+
+
+def page(table: pd.DataFrame, versions: dict, skipped: dict, rounds: int, bandwidth: float) -> str:
+    peers = "; ".join([f"{peer} (" + ", ".join(f"{name} {v}" for name, v in found.items()) + ")"
+                       for peer, found in versions.items()]
+                      + [f"{peer} {why}, skipped" for peer, why in skipped.items()])
+    return render(
+        "sections.html.j2",
+        title="Benchmark: our bootstrap PF and resamplers against peer libraries",
+        up="index.html",
+        up_label="benchmark",
+        meta=f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+        f"numpy {np.__version__}; peers, each in its own venv: {peers}. UNGM, T = {STEPS}; {rounds} "
+        "interleaved rounds (ours, peer, ours, peer, ...) per N; ratio = t_ours / t_peer (below 1: ours is "
+        f"faster). Copy bandwidth {bandwidth / 1e9:.2f} GB/s (read + written). Made by make benchmark "
+        "(benchmarks/peers.py).",
+        sections=[
+            {"title": "t_ours / t_peer over the rounds: median [min, max] (DISAGREES: the peer's estimates "
+                      "are beyond Monte Carlo error of ours, its times are not comparable)",
+             "figure": None, "table": html_table(ratio_cells(table))},
+            {"title": "Time against N: ours, the peers, and the step's bound (memory bandwidth, random "
+                      "numbers)",
+             "figure": "peers.png", "table": ""},
+            {"title": "Per peer and N: the ratios, the agreement (distance against its bound; each side's "
+                      "distance from exact), the median times and the bound's two parts (seconds)",
+             "figure": None, "table": html_table(significant(table))},
+        ],
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--max-n", type=int, default=SIZES[-1], help="the largest N (less for a quick check)")
+    parser.add_argument("--rounds", type=int, default=5, help="A B rounds per peer and N (at least 2)")
+    args = parser.parse_args()
+    if args.rounds < 2:
+        parser.error("--rounds must be at least 2 (the agreement bound needs their spread)")
+    retain_freed_memory()  # as every experiment's run does; the peers get the same thresholds (PEER_ENV)
+    out = resolve("reports") / "benchmark"
+    out.mkdir(parents=True, exist_ok=True)
+    sizes = [n for n in SIZES if n <= args.max_n]
+    print("measuring the copy bandwidth and the time of N normals", flush=True)
+    bandwidth = copy_bandwidth()
+    bound = step_bound(sizes, bandwidth)
+    times, checks, versions, skipped = compare(sizes, args.rounds)
+    table = ratio_table(times, checks, bound)
+    times.to_csv(out / "peers.csv", index=False)
+    table.to_csv(out / "peers_ratios.csv", index=False)
+    figure(times, table, bound, out / "peers.png")
+    (out / "peers.html").write_text(page(table, versions, skipped, args.rounds, bandwidth))
+    with pd.option_context("display.width", 250, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format="%.3g"))
+    print(f"copy bandwidth {bandwidth / 1e9:.2f} GB/s (read + written); written to {out}: peers.csv, "
+          "peers_ratios.csv, peers.png, peers.html")
+
+
+if __name__ == "__main__":
+    main()
