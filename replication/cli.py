@@ -133,7 +133,7 @@ def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
     from replication.runner.execute import BackendError, execute
     from replication.runner.failures import exit_if_failed
-    from replication.runner.store import Store
+    from replication.runner.store import Store, StoreFull
     from replication.runner.validate import prepare
     from replication.runner.variant import differences, report_name
 
@@ -171,7 +171,7 @@ def run_experiment(cfg: DictConfig) -> None:
         else:
             run_companions(cfg)
         exit_if_failed(store, runs)
-    except BackendError as error:
+    except (BackendError, StoreFull) as error:
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
@@ -182,7 +182,7 @@ def run_multiverse(cfg: DictConfig) -> None:
     experiments' stores, then write its report and the index."""
     from replication.runner.execute import BackendError, execute
     from replication.runner.multiverse import load
-    from replication.runner.store import Store
+    from replication.runner.store import Store, StoreFull
     from replication.runner.validate import parallel_settings
 
     try:
@@ -209,7 +209,7 @@ def run_multiverse(cfg: DictConfig) -> None:
         written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
-    except BackendError as error:
+    except (BackendError, StoreFull) as error:
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)

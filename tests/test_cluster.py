@@ -8,6 +8,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 
 import pandas as pd
@@ -69,13 +70,24 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, c
 
 
 @pytest.fixture(scope="module")
-def ray_env():
+def ray_tmpdir():
+    """Ray's sessions and its file naming the last cluster started, in a folder of the tests' own (short:
+    ray's socket paths must fit in 107 characters), removed after; not /tmp/ray, where a later
+    ``ray.init()`` would find a cluster long gone."""
+    folder = tempfile.mkdtemp(prefix="ray", dir="/tmp")
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def ray_env(ray_tmpdir):
     """The environment of every process that starts or joins the test's ray head node: token
     authentication (recent ray's default; ``RAY_AUTH_MODE=token``, as a user's command sets it)
     under a token of the test's own. Ray reads ``RAY_AUTH_TOKEN`` before any token file
     (``RAY_AUTH_TOKEN_PATH``, then ``~/.ray/auth_token``), so the test neither needs a token in the
     home directory (a machine that never ran ray has none) nor writes one there."""
-    return {**os.environ, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(32)}
+    return {**os.environ, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(32),
+            "RAY_TMPDIR": ray_tmpdir}
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +128,7 @@ def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ra
 
 
 @pytest.mark.parametrize("backend", ["threading", "dask", "ray"])
-def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, monkeypatch, backend):
+def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path, monkeypatch, backend, request):
     """threading, and dask and ray with no address (a local cluster of n_jobs workers), against loky.
 
     ray: ``RAY_ADDRESS=local`` makes ``ray.init()`` start that local cluster rather than join one
@@ -131,6 +143,7 @@ def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path,
         pytest.importorskip(package, reason=f"{package} is not installed (pip install -e '.[test]')")
     if backend == "ray":
         monkeypatch.setenv("RAY_ADDRESS", "local")
+        monkeypatch.setenv("RAY_TMPDIR", request.getfixturevalue("ray_tmpdir"))
         monkeypatch.setenv("RAY_AUTH_TOKEN", secrets.token_hex(32))
         if "RAY_AUTH_MODE" not in os.environ:
             monkeypatch.setenv("RAY_AUTH_MODE", "")  # recorded as unset, so removed again at teardown
@@ -142,6 +155,32 @@ def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path,
         assert execute(runs, store, n_jobs=2, backend=name, progress=False) == len(runs)
         frames.append(deterministic_columns(store.load(runs)))
     pd.testing.assert_frame_equal(frames[0], frames[1])
+
+
+def test_an_unreachable_ray_address_is_one_line_at_once(make_cfg, tmp_path):
+    """ray.init retries an address that does not answer for minutes; the runner checks it first."""
+    pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
+    from replication.runner.execute import BackendError
+
+    runs = expand(make_cfg("hspf_ungm", *TINY))
+    started = time.monotonic()
+    with pytest.raises(BackendError) as error:
+        execute(runs, Store(tmp_path, "hspf_ungm"), backend="ray", address="127.0.0.1:9", progress=False)
+    assert str(error.value).startswith("cannot reach ray at parallel.address=127.0.0.1:9: ")
+    assert "\n" not in str(error.value) and time.monotonic() - started < 15
+    assert not (tmp_path / "hspf_ungm").exists()
+
+
+def test_a_local_dask_cluster_serves_its_dashboard_on_the_loopback_only():
+    pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    import distributed
+
+    from replication.runner.execute import _dask_client
+
+    with _dask_client(None, 1):
+        client = distributed.get_client()
+        assert client.dashboard_link.startswith("http://127.0.0.1:"), client.dashboard_link
+        assert client.scheduler.address.startswith("tcp://127.0.0.1:"), client.scheduler.address
 
 
 def test_unreachable_scheduler_is_one_clear_error(make_cfg, tmp_path):

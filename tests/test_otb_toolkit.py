@@ -208,6 +208,8 @@ def test_the_command_line_writes_a_layout(exported, tmp_path, capsys):
         (["experiment=ism_pf_otb", "scale=quick", "experiment.runs.quick=0"], "experiment.runs.quick must be a positive"),
         (["experiment=ism_pf_otb", "scale=quick", "layout=otb"], "no stored run of ism_pf_otb at scale quick is on an OTB"),
         (["experiment=ism_pf_otb", "quick"], "arguments are key=value; got quick"),
+        (["experiment=gps_qmcpf_readings"], "gps_qmcpf_readings is a multiverse: its runs are stored under its "
+                                            "experiments', name one of them: gps_qmcpf, gps_qmcpf_cost"),
     ],
 )
 def test_the_command_line_says_what_is_wrong_in_one_line(args, message, tmp_path, capsys):

@@ -11,6 +11,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 from conftest import PROJECT_ROOT, SMALL
@@ -19,7 +20,7 @@ from joblib import Parallel, delayed
 from replication.cli import check_request
 from replication.errors import ConfigError
 from replication.runner.config import expand
-from replication.runner.execute import TIMING_COLUMNS, execute, parallel_backend, schedule
+from replication.runner.execute import TIMING_COLUMNS, execute, forecast, parallel_backend, schedule
 from replication.runner.store import Store
 from replication.runner.validate import prepare
 
@@ -125,6 +126,54 @@ NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="re
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
 @NEEDS_PROC
+def test_a_request_says_its_size_and_rough_duration_before_it_starts(make_cfg, tmp_path):
+    """How many runs, how many to compute, and about how long: the stored runs' wall times of each method and
+    condition (their mean over every stored run where a condition has none) over the workers."""
+    runs = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=2"))
+    store = Store(tmp_path / "store", "hspf_ungm")
+    assert forecast(runs, runs, store, 2) == \
+        f"hspf_ungm: {len(runs)} runs, {len(runs)} to compute (no stored run of it to time them by)"
+    execute(runs[:3], store, n_jobs=1, backend="threading", progress=False)
+    pending = store.pending(runs)[0]
+    walls = {run.run_id: store.read(run)["wall_s"] for run in runs[:3]}
+    same = {r.run_id: [walls[s.run_id] for s in runs[:3] if (s.method, s.condition) == (r.method, r.condition)]
+            for r in pending}
+    expected = sum(np.mean(same[r.run_id] or list(walls.values())) for r in pending) / 2
+    said = forecast(runs, pending, store, 2)
+    assert said.startswith(f"hspf_ungm: {len(runs)} runs, {len(pending)} to compute, about ")
+    assert said.endswith("on 2 worker(s) (from 3 stored runs' times)")
+    assert said.split("about ")[1].split(" on")[0] == f"{expected:.0f} s"
+
+
+def test_a_full_disk_is_one_line_naming_the_store_and_keeps_what_was_stored(make_cfg, tmp_path, monkeypatch):
+    """No space left mid-run: StoreFull names the folder and says the stored runs are kept (the command line
+    prints it as one line); no temporary file is left, and the same command then completes the rest."""
+    import errno
+
+    import replication.runner.store as store_module
+    from replication.runner.store import StoreFull
+
+    runs = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=2"))
+    store = Store(tmp_path / "store", "hspf_ungm")
+    writes = []
+
+    def filling(path, mode="r", *args, **kwargs):
+        writes.append(path)
+        if len(writes) > 2:
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return open(path, mode, *args, **kwargs)
+
+    monkeypatch.setattr(store_module, "open", filling, raising=False)
+    with pytest.raises(StoreFull) as full:
+        execute(runs, store, n_jobs=1, backend="threading", progress=False)
+    message = str(full.value)
+    assert message.startswith(f"{store.directory}: no space left on its disk") and "kept" in message
+    assert "\n" not in message
+    assert sum(store.has(run) for run in runs) == 2 and not list(store.directory.glob(".*.tmp"))
+    monkeypatch.undo()
+    assert execute(runs, store, n_jobs=1, backend="threading", progress=False) == len(runs) - 2
+
+
 def test_runs_start_scene_by_scene_and_repetition_by_repetition(make_cfg):
     """The schedule keeps every run, puts one repetition's methods and particle counts together inside each
     scene (the runs a comparison pairs are computed close in time), and spreads each condition's runs over
@@ -283,6 +332,9 @@ OTB_SCENE = ("experiment=ism_pf_otb", "experiment.model.sweep.scene=[Girl]")
         (("experiment=hspf_ungm", "experiment.methods.PF.n_particles=abc"),
          "experiment.methods.PF.n_particles must be an integer, got 'abc'"),
         (("experiment=hspf_ungm", "experiment.runs.quick=-1"), "experiment.runs.quick must be a positive integer"),
+        (("experiment=hspf_ungm", "experiment.model.Q=abc"), "experiment.model.Q must be a number, got 'abc'"),
+        (("experiment=hspf_ungm", "experiment.runs.quick=1000000000"),
+         "experiment.runs.quick = 1,000,000,000 runs per condition, against the paper's 100: pass force=true"),
         ((*OTB_SCENE, "+experiment.scenes.Girl.root=/no/such/otb"), "experiment.scenes.Girl.root: no folder"),
     ],
 )

@@ -3,9 +3,10 @@
 Where the runs go is ``parallel.backend`` (see ``conf/config.yaml``): ``loky``
 worker processes on this machine (the default), ``threading``, or a cluster:
 ``dask`` (a ``distributed`` scheduler at ``parallel.address``, or a local
-cluster of ``n_jobs`` worker processes when no address is given) or ``ray``
-(``ray.init(address=parallel.address)``; ray's joblib backend cannot stream
-results, so its records come back and are stored a batch at a time).  Wherever a run is computed, its
+cluster of ``n_jobs`` worker processes on the loopback when no address is given) or ``ray``
+(``ray.init(address=parallel.address)``, an address first checked to answer; no address: a new
+local cluster, never a stale one a past run left named in ray's files; ray's joblib backend cannot
+stream results, so its records come back and are stored a batch at a time).  Wherever a run is computed, its
 record is a pure function of its identity and seed, so every backend stores
 the same numbers; only the records are sent back, and only this process
 writes the store.  Cluster workers need this package (and the same numpy,
@@ -17,6 +18,7 @@ import importlib.util
 import logging
 import os
 import signal
+import socket
 import sys
 import threading
 import time
@@ -24,6 +26,7 @@ import warnings
 from collections.abc import Iterator
 from contextlib import closing, contextmanager
 
+import numpy as np
 from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
@@ -107,8 +110,14 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
         register_ray()
         started = not ray.is_initialized()
         if started:
+            if address:  # ray.init retries an address that does not answer for minutes, printing every 5 s
+                try:
+                    _answers(address)
+                except OSError as error:
+                    raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
             try:
-                ray.init(address=address or None, log_to_driver=False)
+                # no address: a new local cluster, never one named by RAY_ADDRESS or by a file a past one left
+                ray.init(address=address or "local", log_to_driver=False)
             except (ConnectionError, RuntimeError, ValueError) as error:
                 where = f"ray at parallel.address={address}" if address else "ray on this machine"
                 hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
@@ -125,6 +134,14 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
     else:
         with parallel_config(backend=backend, n_jobs=n_jobs):
             yield
+
+
+def _answers(address: str, seconds: float = 10.0) -> None:
+    """A TCP connection to a cluster's ``host:port`` (``ray://host:port`` too) opens within ``seconds``, else
+    OSError; ``auto`` and other names without a port are left to the cluster's own client."""
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if host and port.isdigit():
+        socket.create_connection((host, int(port)), timeout=seconds).close()
 
 
 def start_worker(runner: int) -> None:
@@ -163,7 +180,7 @@ def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
                     n_workers=n_jobs if n_jobs > 0 else None,
                     threads_per_worker=1,
                     processes=True,
-                    dashboard_address=":0",
+                    dashboard_address="127.0.0.1:0",  # the dashboard too on the loopback alone, as the scheduler
                     silence_logs=logging.ERROR,
                 )
             client = Client(cluster)
@@ -207,6 +224,31 @@ def _one_line(error: BaseException) -> str:
     return " ".join(str(error).split()) or error.__class__.__name__
 
 
+def forecast(runs: list[Run], pending: list[Run], store: Store, n_jobs: int, sample: int = 5) -> str:
+    """What a request is about to do, before it does it: how many runs, how many to compute, and roughly how
+    long, from the wall times of up to ``sample`` stored runs of each method and condition (of the same
+    experiment; their mean over all stored runs where a condition has none) over the workers."""
+    said = f"{runs[0].experiment}: {len(runs):,} runs, {len(pending):,} to compute"
+    waiting = {run.run_id for run in pending}
+    seen: dict[tuple[str, str], list[float]] = {}
+    for run in runs:
+        times = seen.setdefault((run.method, str(run.condition)), [])
+        if run.run_id not in waiting and len(times) < sample:
+            record = store.read(run)
+            if record is not None:
+                times.append(float(record["wall_s"]))
+    known = [t for times in seen.values() for t in times]
+    if not known:
+        return f"{said} (no stored run of it to time them by)"
+    workers = min(effective_n_jobs(n_jobs) if n_jobs else 1, len(pending))
+    seconds = sum(np.mean(seen[run.method, str(run.condition)] or known) for run in pending) / max(workers, 1)
+    return f"{said}, about {_duration(seconds)} on {workers} worker(s) (from {len(known)} stored runs' times)"
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
+
+
 def schedule(runs: list[Run]) -> list[Run]:
     """The order runs start in: data condition by data condition (a scene, in the order they come), and in
     each, repetition by repetition, every method and particle count of one repetition together.  So the runs
@@ -243,6 +285,8 @@ def execute(
         print(f"re-running {len(corrupt)} corrupt result file(s): {summarise(corrupt)}", file=sys.stderr)
     if not pending:
         return 0
+    if progress:
+        print(forecast(runs, pending, store, n_jobs), flush=True)
     by_id = {run.run_id: run for run in pending}
     bar = tqdm(
         total=len(runs),

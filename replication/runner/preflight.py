@@ -7,7 +7,7 @@ decodable) is :mod:`replication.runner.validate`'s, after the imports but still 
 
 Numbers are checked by what their key names: every number is finite; a ``sigma`` or a variance is
 positive, a standard deviation (``*_sd``, ``P0``) is not negative; counts (``n_*``, ``steps``, ...)
-are positive integers.  Names that become file names (the experiment's, its methods' and scenes')
+are positive integers; and a key that names one of these holds a number, not a word (``Q=abc``).  Names that become file names (the experiment's, its methods' and scenes')
 are restricted to :data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
 directory unless ``outside_project=true``.
 """
@@ -30,6 +30,7 @@ POSITIVE = re.compile(r"(sigma\w*|\w+_sigma|\w*_var|variance|Q|R)")  # a scale: 
 NOT_NEGATIVE = re.compile(r"(\w+_sd|P0)")  # a standard deviation: zero switches the noise off
 COUNTS = re.compile(r"(n_\w+|runs|steps|frames|iterations|bins|copies|samples)")  # positive integers
 NAMED_BLOCKS = ("methods", "scenes")  # their keys become file and folder names
+BEYOND, MOST_RUNS = 10, 10_000  # runs per condition beyond which a request must say force=true
 
 
 def check_yaml(path: Path) -> None:
@@ -115,6 +116,19 @@ def check_experiment(cfg: DictConfig) -> None:
     values = OmegaConf.to_container(experiment, resolve=True)
     for block in ("runs", "model", "methods", "scenes"):
         check_numbers(values.get(block), f"experiment.{block}", block)
+    check_size(values["runs"], cfg.get("scale"), bool(cfg.get("force")))
+
+
+def check_size(runs: dict, scale: str, force: bool) -> None:
+    """A run count far beyond the paper's (more than :data:`BEYOND` times it, or :data:`MOST_RUNS` runs per
+    condition: a typo of a few zeros) is refused unless ``force=true``: its runs would be expanded and queued
+    before the first is computed."""
+    wanted, paper = runs.get(scale), runs.get("paper")
+    if force or not _integer(wanted) or not _integer(paper):
+        return
+    if wanted > BEYOND * paper or wanted > MOST_RUNS:
+        raise ConfigError(f"experiment.runs.{scale} = {wanted:,} runs per condition, against the paper's {paper:,}: "
+                          "pass force=true to run that many")
 
 
 def check_numbers(value: Any, where: str, key: str = "") -> None:
@@ -129,6 +143,9 @@ def check_numbers(value: Any, where: str, key: str = "") -> None:
         for v in value:
             check_numbers(v, where, key)
         return
+    names_a_number = any(rule.fullmatch(key) for rule in (POSITIVE, NOT_NEGATIVE, COUNTS))
+    if names_a_number and (isinstance(value, (bool, str)) or not isinstance(value, (int, float, type(None)))):
+        raise ConfigError(f"{where} must be {'an integer' if COUNTS.fullmatch(key) else 'a number'}, got {value!r}")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return
     if not math.isfinite(value):

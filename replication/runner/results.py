@@ -35,6 +35,7 @@ import pandas as pd
 from hydra import compose, initialize_config_dir
 from omegaconf import DictConfig
 
+from replication.errors import ConfigError
 from replication.paths import CONF_DIR, resolve
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
@@ -149,9 +150,15 @@ def load_frames(experiment: str, scale: str = "paper", *overrides: str) -> pd.Da
 
 
 def stored_records(experiment: str, scale: str = "paper", *overrides: str) -> tuple[pd.DataFrame, list[Run]]:
-    """The stored records of an experiment's runs, and the runs."""
+    """The stored records of an experiment's runs, and the runs (a multiverse has none of its own: its
+    experiments' runs are theirs, and it says so)."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
+    if "multiverse" in cfg.experiment:
+        named = cfg.experiment.multiverse.experiments
+        named = sorted({e for listed in named.values() for e in listed}) if "paper" in named else list(named)
+        raise ConfigError(f"{experiment} is a multiverse: its runs are stored under its experiments', "
+                          f"name one of them: {', '.join(named)}")
     runs = expand(cfg)
     return Store(resolve(cfg.store), cfg.experiment.name).load(runs), runs
 

@@ -46,6 +46,7 @@ a good record another writer had just put there; the run is then computed
 once more, to the same numbers.
 """
 
+import errno
 import json
 import os
 import secrets
@@ -164,16 +165,19 @@ class Store:
         """Write a new temporary file in the same folder with ``fill(handle)``, then rename it to ``path``.
         The file gets the mode ``open()`` gives (0o666 less the umask: readable by the group and others
         under the usual umask 022), so that a store can be shared."""
-        self.directory.mkdir(parents=True, exist_ok=True)
         tmp = self.directory / f".{secrets.token_hex(8)}.tmp"
         try:
+            self.directory.mkdir(parents=True, exist_ok=True)
             with open(tmp, "x") as handle:  # "x": created here, never an existing file
                 fill(handle)
                 handle.flush()
                 os.fsync(handle.fileno())
             os.replace(tmp, path)
-        except BaseException:
+        except BaseException as error:
             tmp.unlink(missing_ok=True)
+            if isinstance(error, OSError) and error.errno in (errno.ENOSPC, errno.EDQUOT):
+                raise StoreFull(f"{self.directory}: no space left on its disk; every run stored before this one is "
+                                "kept: free some space and rerun the same command to resume") from None
             raise
 
     def load(self, runs: list[Run]) -> pd.DataFrame:
@@ -202,6 +206,10 @@ class Store:
         table = pd.DataFrame.from_records(records)
         typed = pd.DataFrame(conditions, index=table.index, dtype=object)  # N stays an int beside a missing N
         return pd.concat([table, typed], axis=1) if len(typed.columns) else table
+
+
+class StoreFull(OSError):
+    """The store's disk is full: one line saying which folder, and that what is stored is kept."""
 
 
 class CorruptRecord(ValueError):
