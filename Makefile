@@ -65,7 +65,7 @@ readings: setup
 	$(BIN)/python -m replication.report.pdf
 
 benchmark: setup
-	$(BIN)/python benchmarks/benchmark.py
+	$(BIN)/python benchmarks/benchmark.py --instructions
 	$(BIN)/python benchmarks/peers.py
 
 report: setup
