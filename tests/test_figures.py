@@ -255,3 +255,27 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
     assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the median time over runs
     with pytest.raises(ValueError, match="the runs have no"):
         figures.draw(records, {"kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png")
+
+
+def test_error_against_cost_paired_to_a_reference_draws_run_by_run_differences(keep_figures, tmp_path):
+    """``paired_to``: each run's metric minus the reference method's on the same data and repetition, with
+    the paired t interval; the reference is not drawn."""
+    from replication.report.figures import cost as cost_figures
+
+    drawn = keep_figures(cost_figures)
+    base = np.array([4.0, 6.0, 5.0])  # the data's spread, which pairing cancels
+    rows = [("grid", "", 0, base), ("PF", "N=100", 100, base + [0.3, 0.5, 0.4]),
+            ("PF", "N=500", 500, base + [0.1, 0.1, 0.1 + 1e-9])]
+    records = typed(pd.DataFrame([{"method": m, "condition": c, "data_condition": "", "repetition": r, "rmse": v,
+                                   "evaluations_per_step": e, "ms_per_step": 0.1 + e / 1e3}
+                                  for m, c, e, values in rows for r, v in enumerate(values)]))
+    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse", "paired_to": "grid"}, {"methods": {}},
+                 tmp_path / "p.png")
+    work = drawn[0].axes[0]
+    (pf,) = [line for line in work.get_lines() if line.get_label() == "PF"]
+    assert pf.get_ydata() == pytest.approx([0.4, 0.1])
+    band = work.collections[0].get_paths()[0].vertices[:, 1]
+    half = stats.t.ppf(0.975, 2) * 0.1 / np.sqrt(3)  # the differences 0.3, 0.5, 0.4: sd 0.1
+    assert band.max() == pytest.approx(0.4 + half) and band.min() < 0.1 + 1e-6
+    assert "grid" not in [line.get_label() for line in work.get_lines()] + [c.get_label() for c in work.containers]
+    assert "minus grid's" in work.get_ylabel()

@@ -15,6 +15,7 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 from replication.condition import label_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.quantities import quantity  # noqa: E402
+from replication.evidence.statistics import mean  # noqa: E402
 from replication.report.figures.base import figure  # noqa: E402
 from replication.report.figures.style import axis_label, method_label, method_look, save  # noqa: E402
 
@@ -27,12 +28,14 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
     runs; a time's median, which a slow first run does not move; log scale), one panel per cost; a
     method's conditions (its particle counts, say) are joined by a line in order of cost with its
     interval as a band (a single condition: a point with its interval), its other swept variable
-    ``spec.by`` (a scene) split into lines of their own; ``spec.log_y`` puts the metric on a log scale."""
+    ``spec.by`` (a scene) split into lines of their own; ``spec.log_y`` puts the metric on a log scale;
+    ``spec.paired_to`` (a method) draws the metric minus that method's on the same data, run by run."""
     metric, costs = spec["metric"], spec.get("costs", list(COSTS))
     missing = [c for c in (metric, *costs) if c not in records]
     if missing:
         raise ValueError(f"figure {spec.get('name', 'metric_vs_cost')!r}: the runs have no {missing}")
-    y = summarise(records, metric)
+    reference = spec.get("paired_to")
+    y = summarise(records, metric) if reference is None else _paired(records, metric, reference)
     y["line"] = label_of(y, without=[v for v in _swept(y) if v != spec.get("by")], sep=" ") if spec.get("by") else ""
     fig, axes = plt.subplots(1, len(costs), figsize=(6 * len(costs), 4.4), squeeze=False)
     for ax, cost in zip(axes[0], costs):
@@ -59,11 +62,28 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
             ax.set_yscale("log")
             ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
         ax.set_xlabel(f"{axis_label(cost)} ({statistic} over runs, log scale)")
-        ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
+        ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)" if reference is None else
+                      f"{axis_label(metric)} minus {reference}'s\n(same runs; mean and 95% CI)")
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(textwrap.fill(spec.get("title", ""), 120), fontsize=9)
     axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     return save(fig, path, dpi=120)
+
+
+def _paired(records: pd.DataFrame, metric: str, reference: str) -> pd.DataFrame:
+    """``summarise``'s columns for ``metric`` minus the ``reference`` method's on the same data and repetition,
+    run by run (the data's run-to-run spread, which the unpaired intervals carry, cancels), each method and
+    condition's mean with its t interval; the reference itself left out."""
+    theirs = records.loc[records["method"] == reference, ["data_condition", "repetition", metric]]
+    joined = records[records["method"] != reference].merge(theirs, on=["data_condition", "repetition"],
+                                                            suffixes=("", " reference"))
+    variables = [c for c in records.columns if c.startswith("condition.")]
+    rows = []
+    for (method, condition), group in joined.groupby(["method", "condition"], sort=False):
+        found = mean((group[metric] - group[f"{metric} reference"]).to_numpy(dtype=float), -math.inf, math.inf)
+        rows.append({"method": method, "condition": condition, "mean": found.value, "ci_low": found.low,
+                     "ci_high": found.high, **group[variables].iloc[0].to_dict()})
+    return pd.DataFrame(rows, columns=["method", "condition", "mean", "ci_low", "ci_high", *variables])
 
 
 def _two_and_five(value: float, _) -> str:
