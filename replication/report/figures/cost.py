@@ -17,7 +17,7 @@ from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.quantities import quantity  # noqa: E402
 from replication.evidence.statistics import mean  # noqa: E402
 from replication.report.figures.base import figure  # noqa: E402
-from replication.report.figures.style import axis_label, method_label, method_look, save  # noqa: E402
+from replication.report.figures.style import axis_label, method_label, method_look, save, shades  # noqa: E402
 
 COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted, and the time it took
 
@@ -44,16 +44,19 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
         x = x.rename(columns={"mean": "cost"})
         points = y.merge(x, on=["method", "condition"])
         points = points[points["cost"] > 0]  # no work counted: a reference without a likelihood
+        lines = points.groupby("method", sort=False)["line"].unique()  # a method's lines: shades of its colour
         for (method, line), group in points.groupby(["method", "line"], sort=False):
             group = group.sort_values("cost")
             look, label = method_look(method), f"{method_label(experiment, method)} {line}".strip()
+            colour = shades(look.colour, len(lines[method]))[list(lines[method]).index(line)]
+            drawn = {**look.line(), "color": colour}
             if len(group) > 1:  # a line through its budgets, its interval a band
-                ax.plot(group["cost"], group["mean"], **look.line(), markersize=4, label=label)
-                ax.fill_between(group["cost"], group["ci_low"], group["ci_high"], color=look.colour, alpha=0.15,
+                ax.plot(group["cost"], group["mean"], **drawn, markersize=4, label=label)
+                ax.fill_between(group["cost"], group["ci_low"], group["ci_high"], color=colour, alpha=0.15,
                                 linewidth=0)
             else:  # one budget: a point and its interval
                 interval = [group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]]
-                ax.errorbar(group["cost"], group["mean"], yerr=interval, **look.line(), markersize=6, capsize=3,
+                ax.errorbar(group["cost"], group["mean"], yerr=interval, **drawn, markersize=6, capsize=3,
                             elinewidth=0.9, label=label)
         ax.set_xscale("log")
         ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
