@@ -63,21 +63,12 @@ from replication.smc.resampling import RESAMPLERS  # noqa: E402
 from replication.vision.colour import ColourLikelihood  # noqa: E402
 from replication.vision.histogram import ColourHistogram  # noqa: E402
 from likelihood_sides import BINS, CALCHIST, OURS, calchist, scene_frame, scored  # noqa: E402
+from timing import best_of  # noqa: E402
 
 PF_STEP = "bootstrap PF step (UNGM)"
 PAPER_FPS = 5.52  # bis_pf, Table 1: BIS-PF on the 36 balls, 1.4 GHz Pentium 4
 ROUNDS = 5  # each ratio measured this many times in one run: its median and range are reported
 SIDES = Path(__file__).with_name("likelihood_sides.py")  # the child instructions() counts under callgrind
-
-
-def best_of(call, repeats: int = 5) -> float:
-    """Seconds of the fastest of ``repeats`` calls (the least disturbed by the rest of the machine)."""
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - started)
-    return min(times)
 
 
 def likelihood_throughput() -> pd.DataFrame:

@@ -67,6 +67,7 @@ from replication.paths import resolve  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.runner.memory import MMAP_THRESHOLD, TRIM_THRESHOLD, retain_freed_memory  # noqa: E402
 from replication.smc.resampling import RESAMPLERS  # noqa: E402
+from timing import best_of  # noqa: E402
 
 SCRIPTS = Path(__file__).resolve().parent / "peers"
 VENVS = resolve(".peers")
@@ -260,20 +261,11 @@ def compare(sizes, rounds: int) -> tuple[pd.DataFrame, pd.DataFrame, dict, dict]
     return times, checks, versions, skipped
 
 
-def best_seconds(call, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - started)
-    return min(times)
-
-
 def copy_bandwidth(nbytes: int = 2 * 10**8, repeats: int = 5) -> float:
     """Bytes per second of numpy's best copy of ``nbytes`` (the bytes read plus the bytes written)."""
     source = np.ones(nbytes // 8)
     target = np.empty_like(source)
-    return 2 * source.nbytes / best_seconds(lambda: np.copyto(target, source), repeats)
+    return 2 * source.nbytes / best_of(lambda: np.copyto(target, source), repeats)
 
 
 def step_bound(sizes, bandwidth: float, d: int = 1) -> pd.DataFrame:
@@ -282,7 +274,7 @@ def step_bound(sizes, bandwidth: float, d: int = 1) -> pd.DataFrame:
     rng = np.random.default_rng()
     return pd.DataFrame({"N": list(sizes),
                          "bandwidth_bound_s": [8 * n * (4 * d + 4) / bandwidth for n in sizes],
-                         "normal_floor_s": [best_seconds(lambda n=n: rng.standard_normal(n), 5)
+                         "normal_floor_s": [best_of(lambda n=n: rng.standard_normal(n), 5)
                                             for n in sizes]})
 
 

@@ -10,8 +10,8 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.claims import Check, Claim, Reading, Result, load_papers
-from replication.evidence.multiverse import BASIS, EQUAL_N, READING, Case, Robustness, basis_of
+from replication.evidence.claims import EQUAL_N, Check, Claim, Reading, Result, load_papers
+from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.schema import Summary
 from replication.evidence.statistics import Estimate
 from replication.report.pages.multiverse import write_multiverse_report
@@ -193,8 +193,8 @@ def test_equal_cost_is_a_named_choice_of_its_own_twinned_with_its_universe_at_eq
     # default: reproduced vs not reproduced (a conflict); x=b: its own r1 (inconclusive) vs reproduced (none)
     assert (at_time.flips, at_time.compared) == (1, 2) and at_time.moves
     assert "compared at equal time per step (ms) (1 of 2 decisive verdicts conflict)" in robustness.flipped_by
-    assert basis_of(Reading("r", "e", {"test": "order"})) == EQUAL_N
-    assert basis_of(Reading("r", "e", {"test": "equal_cost", "cost": "ms_per_step"})) == "equal time per step (ms)"
+    assert Reading("r", "e", {"test": "order"}).compared_at == EQUAL_N
+    assert Reading("r", "e", {"test": "equal_cost", "cost": "ms_per_step"}).compared_at == "equal time per step (ms)"
 
 
 def test_every_multiverse_config_loads_with_its_defaults_equal_to_the_experiments(tmp_path):

@@ -41,6 +41,7 @@ from replication.evidence.tables import Table, match, pair
 from replication.evidence.settings import INFERENCE
 
 CLAIMS_DIR = CONF_DIR / "claims"
+EQUAL_N = "equal N"  # what a reading at the paper's own settings compares at
 WORK = "evaluations_per_step"  # the work counted beside a time (replication.smc.work)
 
 
@@ -55,6 +56,11 @@ class Reading:
         """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
         they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
         return ClaimTest.registry[self.test["test"]].basis(self.test)
+
+    @property
+    def compared_at(self) -> str:
+        """The same for a reader: "equal N", or "equal <budget>"."""
+        return f"equal {self.basis}" if self.basis else EQUAL_N
 
 
 @dataclass(frozen=True)
@@ -282,7 +288,7 @@ class EqualCost(ClaimTest):
             spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
             budget = float(ours[cost].agg(statistic))
             at = f" at {condition}" if condition else ""
-            what = f"{method}{at} - {baseline} at equal {quantity(cost).label or cost}"
+            what = f"{method}{at} - {baseline} at equal {self.basis(self.spec)}"
             reaching = spent[spent >= budget]
             if reaching.empty:
                 why = f"no condition of {baseline} reaches the budget (at most {spent.max():.4g})"

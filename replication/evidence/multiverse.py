@@ -17,14 +17,8 @@ from replication.evidence.verdict import Outcome, Verdict
 # how close a verdict is to the claim holding: the best case for the paper has the highest
 CLOSENESS = {Outcome.REPRODUCED: 3, Outcome.INCONCLUSIVE: 2, Outcome.NOT_REPRODUCED: 1, Outcome.NOT_TESTABLE: 0}
 READING = "reading"  # the scoring readings, a choice of their own beside the run-level ones
-BASIS = "compared at"  # what the methods are given in common: equal N (the papers'), or a budget of work or time
-EQUAL_N = "equal N"
+BASIS = "compared at"  # what the methods are given in common (Reading.compared_at): equal N, or a budget
 SCORING = (READING, BASIS)  # choices made in scoring the runs, not in running them
-
-
-def basis_of(reading) -> str:
-    """A scoring reading's alternative of :data:`BASIS`."""
-    return f"equal {reading.basis}" if reading.basis else EQUAL_N
 SHOWN_FLIPS = 4  # in a claim's one-line summary; its page lists every case
 
 

@@ -146,7 +146,7 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
                 "number": estimate.value if estimate else None, "ci_low": estimate.low if estimate else None,
                 "ci_high": estimate.high if estimate else None, "runs": estimate.runs if estimate else None,
                 "deciding": deciding.shown if deciding else "",
-                "at_equal_cost": "; ".join(f"{r.verdict.outcome.value} at equal {r.reading.basis}"
+                "at_equal_cost": "; ".join(f"{r.verdict.outcome.value} at {r.reading.compared_at}"
                                            for r in row.at_equal_cost),
                 "reading": row.primary.reading.name, "readings": len(row.results), "robustness": row.robustness,
                 "robust": row.robust, **_across(row),

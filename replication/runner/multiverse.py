@@ -211,11 +211,10 @@ def load(cfg: DictConfig) -> Multiverse:
     unknown = sorted(set(experiments) - set(experiment_names()))
     if unknown:
         raise ConfigError(f"experiment.multiverse.experiments: no experiment {unknown[0]!r}")
-    named = OmegaConf.to_container(exp.multiverse, resolve=True).get("experiments") or ()
-    named = {e for listed in (named.values() if isinstance(named, dict) else [named]) for e in listed}
     bases = {name: _experiment(name) for name in experiments}
-    _check_choices(choices, {**{name: _experiment(name) for name in sorted(named - set(bases))}, **bases},
-                   cfg.scale)
+    others = [name for name in named_experiments(OmegaConf.to_container(exp.multiverse, resolve=True))
+              if name not in bases]
+    _check_choices(choices, {**{name: _experiment(name) for name in others}, **bases}, cfg.scale)
     universes = design(choices, spec.get("design", "full"), int(cfg.base_seed))
     top = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items() if k != "experiment"}
     runs, configs, skipped = {}, {}, {}
@@ -235,6 +234,13 @@ def load(cfg: DictConfig) -> Multiverse:
             skipped.update(dict.fromkeys(missing))
             configs[universe.name, name] = experiment_at_scale(derived)
     return Multiverse(exp.name, exp.paper, experiments, choices, universes, runs, configs, tuple(skipped))
+
+
+def named_experiments(multiverse: dict) -> list[str]:
+    """Every experiment a multiverse block names, at any scale (``experiments: [..]`` or ``{paper: [..],
+    quick: [..]}``), sorted."""
+    listed = multiverse.get("experiments") or ()
+    return sorted({name for names in (listed.values() if isinstance(listed, dict) else [listed]) for name in names})
 
 
 def _experiment(name: str) -> dict:

@@ -7,8 +7,9 @@ decodable) is :mod:`replication.runner.validate`'s, after the imports but still 
 
 Numbers are checked by what their key names: every number is finite; a ``sigma`` or a variance is
 positive, a standard deviation (``*_sd``, ``P0``) is not negative; counts (``n_*``, ``steps``, ...)
-are positive integers; and a key that names one of these holds a number, not a word (``Q=abc``).  Names that become file names (the experiment's, its methods' and scenes')
-are restricted to :data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
+are positive integers; and a key that names one of these holds a number, not a word (``Q=abc``).
+Names that become file names (the experiment's, its methods' and scenes') are restricted to
+:data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
 directory unless ``outside_project=true``.
 """
 

@@ -33,12 +33,13 @@ from pathlib import Path
 
 import pandas as pd
 from hydra import compose, initialize_config_dir
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, resolve
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
+from replication.runner.multiverse import named_experiments
 from replication.runner.store import Store
 from replication.runner.variant import differences, report_name
 from replication.tasks import TASKS
@@ -155,8 +156,7 @@ def stored_records(experiment: str, scale: str = "paper", *overrides: str) -> tu
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
     if "multiverse" in cfg.experiment:
-        named = cfg.experiment.multiverse.experiments
-        named = sorted({e for listed in named.values() for e in listed}) if "paper" in named else list(named)
+        named = named_experiments(OmegaConf.to_container(cfg.experiment.multiverse, resolve=True))
         raise ConfigError(f"{experiment} is a multiverse: its runs are stored under its experiments', "
                           f"name one of them: {', '.join(named)}")
     runs = expand(cfg)

@@ -19,7 +19,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
-from replication.evidence.multiverse import BASIS, READING, Case, Robustness, basis_of
+from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import load_published
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
@@ -48,7 +48,7 @@ def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFram
             for reading in claim.readings:
                 stored = results.get(claim.id, {}).get(reading.name)
                 if stored is not None:
-                    scoring = ((BASIS, basis_of(reading)), (READING, reading.name))
+                    scoring = ((BASIS, reading.compared_at), (READING, reading.name))
                     cases[claim.id].append(Case(universe.name, universe.picks + scoring, stored))
     return [Robustness(claim, tuple(cases[claim.id])) for claim in claims if cases[claim.id]]
 
