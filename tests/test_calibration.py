@@ -50,6 +50,7 @@ def test_the_shipped_table_is_current_complete_and_precise():
     assert len(table) == len(calibration.cases())
     assert (table["mc_se"] <= 0.005 + 1e-12).all()
     assert failures(table).empty
+    assert not failures(table, control=True).empty  # the simulation catches the old rules it replaced
     paper_power = table[(table["test"] == "order") & (table["truth"] == "effect") & (table["effect"] == 1.0)
                         & (table["runs"] == 100)]
     assert (paper_power["power"] >= 0.8).all() and len(paper_power) == 3
@@ -76,3 +77,5 @@ def test_the_page_draws_from_the_stored_table(tmp_path):
     assert "How often the verdict rules err" in html and (page.parent / "null_rates.png").exists()
     assert (page.parent / "power.png").exists() and "1/32" not in html  # the floor is computed: 0.031
     assert "0.031" in html
+    controls = failures(read(tmp_path / CSV), control=True)
+    assert f"{len(controls)} of their null rows exceed 5 %" in html  # the old rules on a section of their own

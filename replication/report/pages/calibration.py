@@ -64,10 +64,10 @@ def read(path: Path) -> pd.DataFrame:
     return pd.read_csv(path, keep_default_na=False, na_values=[""])
 
 
-def failures(table: pd.DataFrame, standard_errors: float = 2.0) -> pd.DataFrame:
-    """The rows of the project's rules (not the controls) whose null rate exceeds 5 % by more than
-    ``standard_errors`` Monte Carlo standard errors."""
-    null = table[(table["truth"] == "null") & ~table["control"].astype(bool)]
+def failures(table: pd.DataFrame, standard_errors: float = 2.0, control: bool = False) -> pd.DataFrame:
+    """The null rows whose rate exceeds 5 % by more than ``standard_errors`` Monte Carlo standard errors: of
+    the project's rules, or (``control``) of the old rules kept as controls, which decide no verdict."""
+    null = table[(table["truth"] == "null") & (table["control"].astype(bool) == control)]
     return null[null["rate"] > INFERENCE.alpha + standard_errors * null["mc_se"]]
 
 
@@ -133,7 +133,7 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     page = out / "index.html"
     page.write_text(render(
         "calibration.html.j2", title="How often the verdict rules err: calibration",
-        failed=failures(table), table=html_table(shown), replications=int(table["replications"].max()),
+        failed=failures(table), controls=failures(table, control=True), table=html_table(shown), replications=int(table["replications"].max()),
         rows=len(table), floor=2.0 ** -5, equivalence_alpha=INFERENCE.equivalence_alpha,
         detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page
