@@ -111,20 +111,47 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
     return [h[: len(p)] / h[: len(p)].sum() for h, p in zip(tallies, particles)]  # np.bincount's minlength=len(p)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _edges(box):
+    """A box (cx, cy, w, h) as (right, left, bottom, top, w, h), computed as :func:`box_overlap` does."""
+    return box[0] + box[2] / 2, box[0] - box[2] / 2, box[1] + box[3] / 2, box[1] - box[3] / 2, box[2], box[3]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _log_phi(a, area_a, b, beta):
+    """:func:`log_potential` of boxes a and b given as :func:`_edges` (and a's w h as ``area_a``), in the
+    same operations and order as its numpy form, so the compiled loops give its numbers to the bit."""
+    dx = min(a[0], b[0]) - max(a[1], b[1])
+    dy = min(a[2], b[2]) - max(a[3], b[3])
+    overlap = (dx if not dx < 0 else 0.0) * (dy if not dy < 0 else 0.0)  # np.clip(., 0, None)
+    ratio = overlap * overlap / (area_a * b[4] * b[5])
+    return -beta * (ratio * ratio)
+
+
+@njit(cache=True, error_model="numpy")
+def log_potential_table(a, b, beta):
+    """The (len(a), len(b)) table of log phi(a_r, b_c): ``log_potential(a[:, None], b[None, :], beta)``
+    in one compiled pass, without its dozen (R, C) temporaries (MFMC's pair blocks)."""
+    edges_b = np.empty((6, b.shape[0]))  # one row per edge, so that the inner loop runs along rows
+    for c in range(b.shape[0]):
+        edges_b[:, c] = _edges(b[c])
+    out = np.empty((a.shape[0], b.shape[0]))
+    for r in range(a.shape[0]):
+        edges_a, area_a = _edges(a[r]), a[r, 2] * a[r, 3]
+        for c in range(b.shape[0]):
+            out[r, c] = _log_phi(edges_a, area_a, edges_b[:, c], beta)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
 def _draw_log_potential(states, draws, pairs, beta):
-    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k:
-    :func:`log_potential` of :func:`box_overlap`, in the same operations and order."""
+    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k."""
     total = np.zeros(draws.shape[1])
     for p in range(pairs.shape[0]):
         i, j = pairs[p, 0], pairs[p, 1]
         for k in range(draws.shape[1]):
             a, b = states[i, draws[i, k]], states[j, draws[j, k]]
-            dx = min(a[0] + a[2] / 2, b[0] + b[2] / 2) - max(a[0] - a[2] / 2, b[0] - b[2] / 2)
-            dy = min(a[1] + a[3] / 2, b[1] + b[3] / 2) - max(a[1] - a[3] / 2, b[1] - b[3] / 2)
-            overlap = (dx if not dx < 0 else 0.0) * (dy if not dy < 0 else 0.0)  # np.clip(., 0, None)
-            ratio = overlap * overlap / (a[2] * a[3] * b[2] * b[3])
-            total[k] += -beta * (ratio * ratio)
+            total[k] += _log_phi(_edges(a), a[2] * a[3], _edges(b), beta)
     return total
 
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.filters.bis import DistributedFilter, cloud_extents, log_potential, neighbours, reaching
+from replication.filters.bis import DistributedFilter, cloud_extents, log_potential_table, neighbours, reaching
 from replication.filters.joint import JointState
 from replication.smc.weights import normalise
 
@@ -36,7 +36,7 @@ class MFMC(DistributedFilter):
         blocks = {}  # (i, j) -> (rows of i, columns of j, log psi between them)
         for i, j in neighbours(particles):
             rows, cols = reaching(particles[i], low[j], high[j]), reaching(particles[j], low[i], high[i])
-            blocks[i, j] = rows, cols, log_potential(particles[i][rows, None], particles[j][None, cols], self.beta)
+            blocks[i, j] = rows, cols, log_potential_table(particles[i][rows], particles[j][cols], float(self.beta))
         with np.errstate(divide="ignore"):
             log_pi = [np.log(p) for p in pi]
         q = list(pi)
