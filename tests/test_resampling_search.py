@@ -45,3 +45,27 @@ def test_schemes_draw_what_they_drew_before(scheme):
             uniforms = (np.arange(n) + before.random()) / n
         expected = np.searchsorted(cumulative_weights(weights), uniforms, side="right")
         np.testing.assert_array_equal(RESAMPLERS[scheme](weights, np.random.default_rng(seed)), expected)
+
+
+def test_cumulative_weights_are_numpys_to_the_bit():
+    rng = np.random.default_rng(4)
+    for weights in weight_sets(rng):
+        expected = np.cumsum(weights)
+        expected /= expected[-1]
+        assert np.array_equal(cumulative_weights(weights).view(np.int64), expected.view(np.int64))
+
+
+def test_systematic_at_the_edges_is_searchsorted():
+    """C_i on the grid of the uniforms (n C_i - first an integer, so the count's estimate is on an edge), the
+    uniform at 0 and just below 1, huge and tiny n: the counting search still returns searchsorted's indices."""
+    from replication.smc.resampling import _cumulative, _systematic_search
+
+    rng = np.random.default_rng(5)
+    for n in (1, 3, 10, 1000, 100_000):
+        grid = np.zeros(n)
+        grid[rng.choice(n, max(1, n // 3), replace=False)] = 1.0  # C takes values k / (n // 3): often on the u grid
+        for weights in (grid, rng.random(n), rng.dirichlet(np.full(n, 0.01))):
+            cumulative = _cumulative(weights)[0]
+            for first in (0.0, 0.5, np.nextafter(1.0, 0.0), float(rng.random()), 1 / 3):
+                expected = np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right")
+                np.testing.assert_array_equal(_systematic_search(cumulative, first, n), expected)

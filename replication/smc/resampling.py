@@ -25,9 +25,26 @@ Resampler = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 def cumulative_weights(weights: np.ndarray) -> np.ndarray:
     """C, the cumulative weights divided by their last entry so that C ends at exactly 1.0 and a
     zero-weight particle (a flat step of C) can never be selected."""
-    cumulative = np.cumsum(weights)
-    cumulative /= cumulative[-1]
-    return cumulative
+    return _cumulative(np.ascontiguousarray(weights, dtype=float))[0]
+
+
+@njit(cache=True, error_model="numpy")
+def _cumulative(weights):
+    """(C, whether C is :func:`_searchable`) in two compiled passes: ``np.cumsum`` (a running sum in
+    index order, so the same bits), then the division by its last entry, checking C on the way."""
+    out = np.empty(weights.size)
+    if not weights.size:
+        return out, False
+    total = weights[0]
+    out[0] = total
+    for i in range(1, weights.size):
+        total = total + weights[i]
+        out[i] = total
+    searchable = True
+    for i in range(weights.size):
+        out[i] = out[i] / total
+        searchable = searchable and np.isfinite(out[i]) and (i == 0 or out[i] >= out[i - 1])
+    return out, searchable
 
 
 def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
@@ -96,18 +113,31 @@ def _guided_search(cumulative, uniforms):
     return out
 
 
-@njit(cache=True)
-def _merge_search(cumulative, first, step, n):
-    """Indices of the sorted uniforms u_k = (k + first) / n (systematic) for k < n: one pass of a
-    merge of u and C, the uniforms made on the fly as numpy makes them."""
+@njit(cache=True, error_model="numpy")
+def _systematic_search(cumulative, first, n):
+    """The indices of the sorted uniforms u_k = (k + first) / n, k < n, as numpy makes them, without a
+    merge's branch per switch between u and C.  For each particle i, m_i = #{k : u_k < C_i} is
+    ceil(n C_i - first), exact unless n C_i - first lies within rounding of an integer, where it is
+    settled by comparing with u_k itself; index i is then below u_k exactly when m_i <= k, so the
+    indices are the running count of the m_i (``np.searchsorted(C, u, side="right")``, bit for bit)."""
+    counts = np.zeros(n + 1, np.int64)
+    margin = 1e-12 * (n + 1.0)  # far above the rounding of n C_i - first and of u_k
+    for i in range(cumulative.size):
+        c = cumulative[i]
+        x = c * n - first
+        m = np.ceil(x)
+        if not (margin < m - x < 1.0 - margin):  # near an integer (or outside [0, n]): compare with u_k
+            m = min(max(m, 0.0), float(n))
+            while m < n and (m + first) / n < c:
+                m += 1.0
+            while m > 0 and (m - 1.0 + first) / n >= c:
+                m -= 1.0
+        counts[int(min(max(m, 0.0), float(n)))] += 1
     out = np.empty(n, np.int64)
-    size = cumulative.size
-    i = 0
+    running = 0
     for k in range(n):
-        u = (k + first) / step
-        while i < size and cumulative[i] <= u:
-            i += 1
-        out[k] = i
+        running += counts[k]
+        out[k] = running
     return out
 
 
@@ -148,9 +178,9 @@ def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None 
 def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """One uniform in each stratum ``[k/N, (k+1)/N)`` (Kitagawa, 1996)."""
     n = len(weights)
-    cumulative = cumulative_weights(weights)
+    cumulative, searchable = _cumulative(np.ascontiguousarray(weights, dtype=float))
     uniforms = _stratified_uniforms(rng.random(n), n)
-    if not _searchable(cumulative) or not _is_sorted(uniforms):
+    if not searchable or not _is_sorted(uniforms):
         return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
     return _merge_sorted(cumulative, uniforms)
 
@@ -158,11 +188,11 @@ def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 def systematic(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """A single uniform shared by all strata: ``u_k = (k + U) / N`` (Carpenter et al., 1999)."""
     n = len(weights)
-    cumulative = cumulative_weights(weights)
+    cumulative, searchable = _cumulative(np.ascontiguousarray(weights, dtype=float))
     first = rng.random()
-    if not _searchable(cumulative):
+    if not searchable:
         return np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right").astype(np.int64)
-    return _merge_search(cumulative, first, n, n)
+    return _systematic_search(cumulative, first, n)
 
 
 def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
