@@ -136,3 +136,36 @@ def test_detection_overlap_is_one_for_the_detections_themselves_and_the_mean_bes
     # frame 1: IoU 50 / 150 with the first detection; frame 3 has none: 0
     assert detection_overlap(shifted, detections) == pytest.approx((50 / 150 + 0.0) / 2)
     assert np.isnan(detection_overlap(shifted.iloc[:0], detections))
+
+
+def test_by_frame_is_the_groupby_it_replaced():
+    """Frames in order of first appearance, rows in table order, ids, boxes and row labels as the
+    DataFrame groupby gave them; a table without ids gets -1."""
+    from replication.metrics.mot import BOX, by_frame
+
+    rng = np.random.default_rng(2)
+    frames = rng.integers(1, 30, 400)
+    tab = pd.DataFrame({"frame": frames, "id": rng.integers(1, 9, 400), **{c: rng.uniform(0, 99, 400) for c in BOX}},
+                       index=rng.permutation(1000)[:400])
+    split = by_frame(tab)
+    groups = list(tab.groupby("frame", sort=False))
+    assert list(split) == [frame for frame, _ in groups]
+    for frame, rows in groups:
+        np.testing.assert_array_equal(split[frame].ids, rows["id"].to_numpy())
+        np.testing.assert_array_equal(split[frame].boxes, rows[BOX].to_numpy())
+        assert list(split[frame].index) == list(rows.index)
+    assert by_frame(tab.drop(columns="id"))[frames[0]].ids.tolist() == [-1] * int((frames == frames[0]).sum())
+    assert by_frame(tab.iloc[:0]) == {}
+
+
+def test_boosted_proposal_density_is_scipys_normal():
+    from scipy.stats import norm
+
+    from replication.models.boosted import normal_logpdf
+
+    rng = np.random.default_rng(3)
+    x = rng.normal(100, 30, (3000, 4))
+    x[0, 0], x[1, 1] = np.inf, -np.inf
+    for mean, sd in ((rng.normal(100, 30, 4), rng.uniform(0.1, 20, 4)), (x[::-1] + 1.0, np.array([3.0, 3.0, 0.3, 0.3]))):
+        ours, scipys = normal_logpdf(x, mean, sd), norm.logpdf(x, mean, sd)
+        assert np.array_equal(ours.view(np.int64), scipys.view(np.int64))  # the same bits, infinities included

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 from trackeval.metrics import HOTA
 
-from replication.metrics.mot import BOX, _by_frame, drop_ignored, iou_matrix
+from replication.metrics.mot import NO_ROWS, by_frame, drop_ignored, iou_matrix
 
 SCORES = {  # our key: TrackEval's field, averaged over alpha
     "hota": "HOTA",
@@ -65,14 +65,13 @@ def hota_data(
     _check_unique(truth, "truth")
     _check_unique(kept, "hypotheses")
     truth_ids, hypothesis_ids = np.unique(truth["id"]), np.unique(kept["id"])
-    tru, hyp = _by_frame(truth), _by_frame(kept)
-    empty = truth.iloc[:0]
+    tru, hyp = by_frame(truth), by_frame(kept)
     data = {"gt_ids": [], "tracker_ids": [], "similarity_scores": []}
     for frame in sorted(tru.keys() | hyp.keys()):
-        t, h = tru.get(frame, empty), hyp.get(frame, empty)
-        data["gt_ids"].append(np.searchsorted(truth_ids, t["id"].to_numpy()))
-        data["tracker_ids"].append(np.searchsorted(hypothesis_ids, h["id"].to_numpy()))
-        data["similarity_scores"].append(iou_matrix(t[BOX].to_numpy(), h[BOX].to_numpy()))
+        t, h = tru.get(frame, NO_ROWS), hyp.get(frame, NO_ROWS)
+        data["gt_ids"].append(np.searchsorted(truth_ids, t.ids))
+        data["tracker_ids"].append(np.searchsorted(hypothesis_ids, h.ids))
+        data["similarity_scores"].append(iou_matrix(t.boxes, h.boxes))
     data.update(
         num_timesteps=len(data["gt_ids"]),
         num_gt_ids=len(truth_ids),

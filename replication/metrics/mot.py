@@ -20,6 +20,8 @@ rule to flag-0 boxes, so our false positives on PETS09-S2L1 can be fewer than th
 MOT15 leaderboard's.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
@@ -46,31 +48,52 @@ def match_boxes(a: np.ndarray, b: np.ndarray, min_iou: float) -> tuple[np.ndarra
     return rows[keep], cols[keep]
 
 
-def _by_frame(table: pd.DataFrame) -> dict:
-    return {frame: rows for frame, rows in table.groupby("frame", sort=False)}
+@dataclass(frozen=True)
+class FrameRows:
+    """One frame's rows of a box table as arrays: their ``ids`` (-1 where the table has none), ``boxes``
+    (x, y, w, h) and row labels (``index``)."""
+
+    ids: np.ndarray
+    boxes: np.ndarray
+    index: pd.Index
+
+
+NO_ROWS = FrameRows(np.zeros(0, np.int64), np.zeros((0, 4)), pd.Index([]))
+
+
+def by_frame(table: pd.DataFrame) -> dict:
+    """Each frame's :class:`FrameRows`, frames in order of first appearance and rows in table order (as
+    ``groupby("frame", sort=False)``), split from whole-table arrays in one pass rather than indexed out
+    of a DataFrame per frame (a pandas lookup cost about 150 us, a third of a MOT run's time)."""
+    codes, frames = pd.factorize(table["frame"], sort=False)
+    order = np.argsort(codes, kind="stable")
+    cuts = np.flatnonzero(np.diff(codes[order])) + 1
+    ids = table["id"].to_numpy() if "id" in table else np.full(len(table), -1)
+    boxes = table[BOX].to_numpy()
+    return {frame: FrameRows(ids[rows], boxes[rows], table.index[rows])
+            for frame, rows in zip(frames, np.split(order, cuts) if len(order) else [])}
 
 
 def drop_ignored(
     hypotheses: pd.DataFrame, truth: pd.DataFrame, ignored: pd.DataFrame, min_iou: float = 0.5
 ) -> pd.DataFrame:
     """``hypotheses`` without the rows the joint assignment gives to an ignore box (module docstring)."""
-    hyp, tru, ign = _by_frame(hypotheses), _by_frame(truth), _by_frame(ignored)
+    hyp, tru, ign = by_frame(hypotheses), by_frame(truth), by_frame(ignored)
     dropped = []
     for frame in hyp.keys() & ign.keys():
-        targets = tru[frame][BOX].to_numpy() if frame in tru else np.zeros((0, 4))
-        rows, cols = match_boxes(hyp[frame][BOX].to_numpy(), np.vstack([targets, ign[frame][BOX].to_numpy()]), min_iou)
+        targets = tru.get(frame, NO_ROWS).boxes
+        rows, cols = match_boxes(hyp[frame].boxes, np.vstack([targets, ign[frame].boxes]), min_iou)
         dropped.extend(hyp[frame].index[rows[cols >= len(targets)]])
     return hypotheses.drop(index=dropped)
 
 
 def frame_distances(truth: pd.DataFrame, hypotheses: pd.DataFrame, min_iou: float = 0.5):
     """Per frame with truth or hypotheses, in order: (truth ids, hypothesis ids, 1 - IoU, NaN below ``min_iou``)."""
-    tru, hyp = _by_frame(truth), _by_frame(hypotheses)
-    empty = truth.iloc[:0]
+    tru, hyp = by_frame(truth), by_frame(hypotheses)
     for frame in sorted(tru.keys() | hyp.keys()):
-        t, h = tru.get(frame, empty), hyp.get(frame, empty)
-        distance = 1.0 - iou_matrix(t[BOX].to_numpy(), h[BOX].to_numpy())
-        yield t["id"].to_numpy(), h["id"].to_numpy(), np.where(distance <= 1.0 - min_iou, distance, np.nan)
+        t, h = tru.get(frame, NO_ROWS), hyp.get(frame, NO_ROWS)
+        distance = 1.0 - iou_matrix(t.boxes, h.boxes)
+        yield t.ids, h.ids, np.where(distance <= 1.0 - min_iou, distance, np.nan)
 
 
 def mot_metrics(
@@ -127,7 +150,7 @@ def detection_overlap(hypotheses: pd.DataFrame, detections: pd.DataFrame) -> flo
     are its own.  NaN without a hypothesis."""
     if hypotheses.empty:
         return float("nan")
-    found = _by_frame(detections)
-    best = [iou_matrix(rows[BOX].to_numpy(), found[frame][BOX].to_numpy()).max(axis=1) if frame in found
-            else np.zeros(len(rows)) for frame, rows in _by_frame(hypotheses).items()]
+    found = by_frame(detections)
+    best = [iou_matrix(rows.boxes, found[frame].boxes).max(axis=1) if frame in found
+            else np.zeros(len(rows.boxes)) for frame, rows in by_frame(hypotheses).items()]
     return float(np.concatenate(best).mean())

@@ -21,9 +21,18 @@ Okuma et al. use the detections in the proposal only (``detection_term: None``).
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import norm
 
 from replication.models.box import BoxModel
+
+LOG_SQRT_2PI = float(np.log(np.sqrt(2 * np.pi)))  # scipy.stats' _norm_pdf_logC
+
+
+def normal_logpdf(x: np.ndarray, mean: np.ndarray, sd: np.ndarray) -> np.ndarray:
+    """log N(x; mean, sd^2) elementwise, for sd > 0: ``scipy.stats.norm.logpdf(x, mean, sd)`` by its own
+    formula, -z^2 / 2 - log sqrt(2 pi) - log sd with z = (x - mean) / sd, so the same bits (inf gives
+    -inf, nan nan), without its 100 us of argument checking per call (13,000 calls in a PETS run)."""
+    z = (x - mean) / sd
+    return -(z**2) / 2.0 - LOG_SQRT_2PI - np.log(np.broadcast_to(sd, z.shape))
 
 
 @dataclass
@@ -59,8 +68,8 @@ class BoostedBoxModel(BoxModel):
         sd = self.detection_sd * self.detection[[2, 3, 2, 3]]
         chosen = rng.random(len(moved)) < self.alpha
         moved[chosen] = self.constrain(self.detection + sd * rng.standard_normal((int(chosen.sum()), 4)))
-        log_prior = norm.logpdf(moved, particles, self.step_sd).sum(axis=1)
-        log_detection = norm.logpdf(moved, self.detection, sd).sum(axis=1)
+        log_prior = normal_logpdf(moved, particles, self.step_sd).sum(axis=1)
+        log_detection = normal_logpdf(moved, self.detection, sd).sum(axis=1)
         with np.errstate(divide="ignore"):
             log_q = np.logaddexp(np.log(self.alpha) + log_detection, np.log1p(-self.alpha) + log_prior)
         return moved, log_prior - log_q
@@ -73,4 +82,4 @@ class BoostedBoxModel(BoxModel):
         if self.detection_term is None or self.detection is None:
             return colour
         sd = self.detection_term * self.detection[[2, 3, 2, 3]]
-        return colour + norm.logpdf(particles[:, :4], self.detection, sd).sum(axis=1)
+        return colour + normal_logpdf(particles[:, :4], self.detection, sd).sum(axis=1)

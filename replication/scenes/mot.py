@@ -17,11 +17,11 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pandas as pd
 
 from replication.paths import resolve
+from replication.scenes.decoded import decoded
 from replication.scenes.factory import SequenceMissing
 
 SHIPPED_MOT_ROOT = "../shared/data/mot"  # where the project's own MOTChallenge sequences are, beside it
@@ -49,14 +49,11 @@ class MotSequence:
     image_ext: str
 
     def image(self, frame: int) -> np.ndarray:
-        """Frame number ``frame`` (1..n_frames, MOT's numbering) as uint8 BGR."""
+        """Frame number ``frame`` (1..n_frames, MOT's numbering) as read-only uint8 BGR, decoded once per
+        process (:mod:`replication.scenes.decoded`)."""
         if not 1 <= frame <= self.n_frames:
             raise IndexError(f"{self.name}: frame {frame} outside 1..{self.n_frames}")
-        path = self.image_dir / f"{frame:06d}{self.image_ext}"
-        image = cv2.imread(str(path), cv2.IMREAD_COLOR)
-        if image is None:
-            raise OSError(f"cannot read {path}")
-        return image
+        return decoded(self.image_dir / f"{frame:06d}{self.image_ext}")
 
 
 def read_rows(path: Path, n_frames: int, ground_truth: bool) -> np.ndarray:

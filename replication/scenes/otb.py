@@ -12,12 +12,12 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import cv2
 import numpy as np
 import yaml
 from PIL import Image, UnidentifiedImageError
 
 from replication.paths import resolve
+from replication.scenes.decoded import decoded
 
 SHIPPED_OTB_ROOT = "../shared/data/otb"  # where the project's own OTB sequences are, beside it
 OTB_ROOT = os.environ.get("REPLICATION_OTB") or SHIPPED_OTB_ROOT  # data.otb in conf/config.yaml
@@ -73,10 +73,8 @@ class OTBSequence:
         self.size = frame_size(self._frames)
 
     def frame(self, k: int) -> np.ndarray:
-        image = cv2.imread(str(self._frames[k]), cv2.IMREAD_COLOR)
-        if image is None:
-            raise OSError(f"cannot read {self._frames[k]}")
-        return image
+        """Frame k as read-only uint8 BGR, decoded once per process (:mod:`replication.scenes.decoded`)."""
+        return decoded(self._frames[k])
 
 
 def check_truth(boxes: np.ndarray, path: Path, first: int) -> None:

@@ -55,10 +55,29 @@ def _contributions(bins: tuple[int, int, int]) -> np.ndarray:
 
 
 def hsv_bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
-    """(H, W) uint16 image of joint HSV bin indices ``(h * Bs + s) * Bv + v`` of a BGR frame."""
+    """(H, W) uint16 image of joint HSV bin indices ``(h * Bs + s) * Bv + v`` of a BGR frame.
+
+    A read-only frame (one a sequence keeps for its next run: :class:`replication.scenes.mot.MotSequence`)
+    gets its bin image computed once per ``bins`` and kept while the frame lives (read-only too)."""
     if max(bins) > 256:
         raise ValueError(f"at most 256 bins per channel, got {bins}")
-    terms = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(tuple(bins)))
+    if frame.flags.writeable:
+        return _bin_image(frame, tuple(bins))
+    made = _BIN_IMAGES.get(id(frame))
+    if made is None or made[0]() is not frame:
+        made = _BIN_IMAGES[id(frame)] = weakref.ref(frame, lambda _, key=id(frame): _BIN_IMAGES.pop(key, None)), {}
+    image = made[1].get(tuple(bins))
+    if image is None:
+        image = made[1][tuple(bins)] = _bin_image(frame, tuple(bins))
+        image.flags.writeable = False
+    return image
+
+
+_BIN_IMAGES: dict = {}  # id of a read-only frame -> (weak reference to it, {bins: its bin image})
+
+
+def _bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
+    terms = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(bins))
     return cv2.transform(terms, _SUM_CHANNELS)
 
 
