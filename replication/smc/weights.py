@@ -31,9 +31,11 @@ def normalise(log_weights: np.ndarray) -> tuple[np.ndarray, float]:
         raise NotFinite("log-weights contain NaN or +inf")
     if top == -np.inf:
         raise DegenerateWeightsError("every log-weight is -inf")
-    weights = np.exp(log_weights - top)
+    weights = np.subtract(log_weights, top)  # in place from here: one array, not three
+    np.exp(weights, out=weights)
     total = weights.sum()
-    return weights / total, float(top + np.log(total))
+    weights /= total
+    return weights, float(top + np.log(total))
 
 
 def ess(weights: np.ndarray) -> float:
