@@ -3,6 +3,7 @@
 # make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
+#                  (where one run's time goes: python benchmarks/profile_run.py EXPERIMENT METHOD [TEXT] [--scale paper])
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)

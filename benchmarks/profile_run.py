@@ -1,0 +1,65 @@
+"""Where one run's time goes: ``python benchmarks/profile_run.py EXPERIMENT METHOD [TEXT] [--scale paper]``.
+
+Profiles (``cProfile``) the first repetition of ``METHOD``'s first run whose condition or scene contains
+``TEXT`` (``N=800``, ``pets``) and prints the functions taking the most time of their own, and the share of
+the run that the project's modules, numpy, pandas, scipy and OpenCV take.  Nothing is stored.  The
+profiler's overhead is mostly per Python call, so shares of code that makes many small calls read high.
+
+    python benchmarks/profile_run.py bis_pf_cost MFMC N=800 --scale paper
+"""
+
+import argparse
+import cProfile
+import pstats
+import sys
+from collections import Counter
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from hydra import compose, initialize_config_dir  # noqa: E402
+
+from replication.paths import CONF_DIR  # noqa: E402
+from replication.runner.config import expand  # noqa: E402
+from replication.runner.execute import perform  # noqa: E402
+
+PARTS = {"replication/": "replication", "numpy": "numpy", "pandas/": "pandas", "scipy/": "scipy",
+         "numba/": "numba", "llvmlite/": "numba", "cv2": "OpenCV", "{imread}": "OpenCV", "{imdecode}": "OpenCV",
+         "{cvtColor}": "OpenCV", "{LUT}": "OpenCV", "{transform}": "OpenCV", "trackeval/": "TrackEval"}
+
+
+def part(filename: str, function: str) -> str:
+    """Which library a profiled function belongs to: by its file, or for a built-in (file ``~``: numpy's
+    ufunc methods, OpenCV's functions) by its name; ``Python`` for the interpreter and the rest."""
+    where = f"{{{function}}}" if filename == "~" else filename
+    return next((name for key, name in PARTS.items() if key in where), "Python")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("experiment")
+    parser.add_argument("method")
+    parser.add_argument("text", nargs="?", default="", help="a piece of the run's condition or scene")
+    parser.add_argument("--scale", default="quick")
+    parser.add_argument("--top", type=int, default=20)
+    args = parser.parse_args()
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=[f"experiment={args.experiment}", f"scale={args.scale}"])
+    runs = [run for run in expand(cfg) if run.method == args.method and run.repetition == 0
+            and args.text in f"{run.condition} {run.data_condition}"]
+    if not runs:
+        sys.exit(f"{args.experiment} at {args.scale} scale has no run of {args.method!r} matching {args.text!r}")
+    profile = cProfile.Profile()
+    profile.runcall(perform, runs[0])
+    stats = pstats.Stats(profile)
+    total = sum(row[2] for row in stats.stats.values())  # own time of every function: the run's time
+    shares = Counter()
+    for (filename, _, function), row in stats.stats.items():
+        shares[part(filename, function)] += row[2]
+    print(f"{runs[0].run_id}: {total:.1f} s under the profiler")
+    print("  " + ", ".join(f"{name} {seconds / total:.0%}" for name, seconds in shares.most_common()))
+    stats.sort_stats("tottime").print_stats(args.top)
+
+
+if __name__ == "__main__":
+    main()
