@@ -8,7 +8,13 @@ from numba import vectorize
 LOG_2PI = float(np.log(2.0 * np.pi))
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True)
+def elementwise(signature: str):
+    """A scalar function compiled into a numpy ufunc (numba's ``vectorize`` for one signature): one pass
+    over its arrays, broadcasting like numpy's own, called without numba's dispatcher (1 us, not 2)."""
+    return lambda function: vectorize([signature], cache=True)(function).ufunc
+
+
+@elementwise("float64(float64, float64, float64, float64)")
 def log_normal_density(x, mean, variance, log_variance):
     """log N(x; mean, variance) = -(((x - mean)^2 / variance + log variance) + log 2 pi) / 2, one compiled
     pass over the particles in numpy's operations and order (so its bits), with no temporaries."""
@@ -16,7 +22,7 @@ def log_normal_density(x, mean, variance, log_variance):
     return -0.5 * (residual * residual / variance + log_variance + LOG_2PI)
 
 
-@vectorize(["float64(float64, float64, float64)"], cache=True)
+@elementwise("float64(float64, float64, float64)")
 def _shifted(mean, scale, noise):
     """mean + scale * noise in one pass, as numpy computes it."""
     return mean + scale * noise

@@ -3,18 +3,17 @@
 from dataclasses import dataclass
 
 import numpy as np
-from numba import vectorize
 
-from replication.models.additive import AdditiveGaussianModel
+from replication.models.additive import AdditiveGaussianModel, elementwise
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@elementwise("float64(float64, float64)")
 def _growth(x, drift):
     """0.5 x + 25 x / (1 + x^2) + drift, in numpy's operations and order: one compiled pass."""
     return 0.5 * x + 25.0 * x / (1.0 + x * x) + drift
 
 
-@vectorize(["float64(float64)"], cache=True)
+@elementwise("float64(float64)")
 def _square_over_20(x):
     return x * x / 20.0
 
