@@ -68,4 +68,5 @@ def test_systematic_at_the_edges_is_searchsorted():
             cumulative = _cumulative(weights)[0]
             for first in (0.0, 0.5, np.nextafter(1.0, 0.0), float(rng.random()), 1 / 3):
                 expected = np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right")
-                np.testing.assert_array_equal(_systematic_search(cumulative, first, n), expected)
+                found = _systematic_search(cumulative, first, np.zeros(n + 1, np.int64), np.empty(n, np.int64))
+                np.testing.assert_array_equal(found, expected)

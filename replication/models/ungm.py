@@ -4,7 +4,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from replication.models.additive import AdditiveGaussianModel, elementwise
+from replication.compiled import elementwise
+from replication.models.additive import AdditiveGaussianModel
 
 
 @elementwise("float64(float64, float64)")

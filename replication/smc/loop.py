@@ -208,30 +208,40 @@ class ParticleFilter:
             weights, log_total = normalise(predicted)
             degenerate = True
         state.log_evidence += log_total
-        return Weighed(particles, weights, log_weights - log_total, degenerate)
+        return Weighed(particles, weights, log_weights, log_total, degenerate)
 
     def conclude(self, state: FilterState, weighed: "Weighed") -> None:
         """The second half: record the estimate of the weighted particles, then resample if the policy wants."""
-        n, particles, log_weights = self.n_particles, weighed.particles, weighed.log_weights
+        n, particles = self.n_particles, weighed.particles
         state.records.add(particles, weighed.weights, weighed.degenerate)
         do_resample = self.resampling.wants(state.records.ess[-1], n)
         if do_resample:
             particles = particles[RESAMPLERS[self.resampling.scheme](weighed.weights, state.rng)]
             log_weights = np.full(n, -np.log(n))
+        else:
+            log_weights = weighed.log_weights
         state.records.resampled.append(do_resample)
         state.particles, state.log_weights = particles, log_weights
 
 
 @dataclass
 class Weighed:
-    """A step's weighted particles before resampling: normalised ``weights`` and their logs."""
+    """A step's weighted particles before resampling: normalised ``weights``, and their logs as the
+    unnormalised log-weights and their log-sum (formed only when asked for: a step that resamples
+    never needs them)."""
 
     particles: np.ndarray
     weights: np.ndarray
-    log_weights: np.ndarray
+    log_unnormalised: np.ndarray
+    log_total: float
     degenerate: bool
+
+    @property
+    def log_weights(self) -> np.ndarray:
+        """log W_i = lw_i - logsumexp(lw)."""
+        return self.log_unnormalised - self.log_total
 
     def reweighted(self, weights: np.ndarray) -> "Weighed":
         """The same particles under other normalised weights (a multi-target interaction's)."""
         with np.errstate(divide="ignore"):
-            return Weighed(self.particles, weights, np.log(weights), self.degenerate)
+            return Weighed(self.particles, weights, np.log(weights), 0.0, self.degenerate)

@@ -6,12 +6,17 @@ of those counts.  See Douc, Cappé and Moulines (2005), "Comparison of
 resampling schemes for particle filtering".
 
 Every scheme finds its indices by inverse CDF in linear time, compiled, with
-no binary search: stratified and systematic uniforms come sorted, so one merge
-pass over them and C; multinomial ones do not, and a guide table (Chen and
-Asau, 1974: the first index of C past each of N equal slices of [0, 1)) starts
-each uniform's search at most a few steps from its index.  Both compare u with
-the same C as ``np.searchsorted(C, u, side="right")`` and return exactly its
-indices, from the same uniforms drawn in the same order.
+no binary search: systematic uniforms lie on a grid, so each particle's count of
+uniforms below C_i is computed rather than searched; stratified ones come sorted,
+so one merge pass over them and C; multinomial ones do not, and a guide table
+(Chen and Asau, 1974: the first index of C past each of N equal slices of
+[0, 1)) starts each uniform's search at most a few steps from its index.  All
+compare u with the same C as ``np.searchsorted(C, u, side="right")`` and return
+exactly its indices, from the same uniforms drawn in the same order.
+
+The compiled kernels write into arrays numpy allocates: an array numba allocates
+page-faults its memory in again at every call in a filter's loop (about 400
+faults, 6 of a step's 31 ms at N = 10^6), where numpy's large arrays are reused.
 """
 
 from collections.abc import Callable
@@ -25,16 +30,22 @@ Resampler = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 def cumulative_weights(weights: np.ndarray) -> np.ndarray:
     """C, the cumulative weights divided by their last entry so that C ends at exactly 1.0 and a
     zero-weight particle (a flat step of C) can never be selected."""
-    return _cumulative(np.ascontiguousarray(weights, dtype=float))[0]
+    return _cumulative(weights)[0]
+
+
+def _cumulative(weights: np.ndarray) -> tuple[np.ndarray, bool]:
+    """(C, whether C is :func:`_searchable`)."""
+    weights = np.ascontiguousarray(weights, dtype=float)
+    out = np.empty(weights.size)  # numpy's arrays, not numba's: see the module docstring
+    return out, _fill_cumulative(weights, out)
 
 
 @njit(cache=True, error_model="numpy")
-def _cumulative(weights):
-    """(C, whether C is :func:`_searchable`) in two compiled passes: ``np.cumsum`` (a running sum in
-    index order, so the same bits), then the division by its last entry, checking C on the way."""
-    out = np.empty(weights.size)
+def _fill_cumulative(weights, out):
+    """C into ``out`` in two compiled passes: ``np.cumsum`` (a running sum in index order, so the same
+    bits), then the division by its last entry, checking on the way that C is searchable."""
     if not weights.size:
-        return out, False
+        return False
     total = weights[0]
     out[0] = total
     for i in range(1, weights.size):
@@ -44,7 +55,7 @@ def _cumulative(weights):
     for i in range(weights.size):
         out[i] = out[i] / total
         searchable = searchable and np.isfinite(out[i]) and (i == 0 or out[i] >= out[i - 1])
-    return out, searchable
+    return searchable
 
 
 def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
@@ -57,7 +68,8 @@ def search(cumulative: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     uniforms = np.ascontiguousarray(uniforms, dtype=float)
     if uniforms.ndim != 1 or not len(cumulative) or not _searchable(cumulative):
         return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
-    return _guided_search(cumulative, uniforms)
+    return _guided_search(cumulative, uniforms, np.empty(4 * len(cumulative) + 1, np.int64),
+                          np.empty(uniforms.size, np.int64))
 
 
 @njit(cache=True)
@@ -73,7 +85,7 @@ def _searchable(cumulative):
 
 
 @njit(cache=True)
-def _guided_search(cumulative, uniforms):
+def _guided_search(cumulative, uniforms, guide, out):
     """For each u the first i with C_i > u (len(C) if none), as ``searchsorted(side="right")``.
 
     A guide table over 4N slices of [0, C_N) gives, for the slice u falls in, an index at or
@@ -83,10 +95,8 @@ def _guided_search(cumulative, uniforms):
     edge); the answer is then exact whatever the rounding.
     """
     n, k = cumulative.size, uniforms.size
-    out = np.empty(k, np.int64)
     top = cumulative[n - 1]
-    slices = 4 * n  # a few slices per index: most uniforms need no step or one
-    guide = np.empty(slices + 1, np.int64)
+    slices = guide.size - 1  # 4 N: a few slices per index, so most uniforms need no step or one
     i = 0
     for b in range(slices + 1):  # guide[b]: the first i with C_i > b / slices * top
         edge = b / slices * top
@@ -114,13 +124,14 @@ def _guided_search(cumulative, uniforms):
 
 
 @njit(cache=True, error_model="numpy")
-def _systematic_search(cumulative, first, n):
+def _systematic_search(cumulative, first, counts, out):
     """The indices of the sorted uniforms u_k = (k + first) / n, k < n, as numpy makes them, without a
     merge's branch per switch between u and C.  For each particle i, m_i = #{k : u_k < C_i} is
     ceil(n C_i - first), exact unless n C_i - first lies within rounding of an integer, where it is
     settled by comparing with u_k itself; index i is then below u_k exactly when m_i <= k, so the
     indices are the running count of the m_i (``np.searchsorted(C, u, side="right")``, bit for bit)."""
-    counts = np.zeros(n + 1, np.int64)
+    n = out.size
+    counts[:] = 0  # n + 1 of them
     margin = 1e-12 * (n + 1.0)  # far above the rounding of n C_i - first and of u_k
     for i in range(cumulative.size):
         c = cumulative[i]
@@ -133,7 +144,6 @@ def _systematic_search(cumulative, first, n):
             while m > 0 and (m - 1.0 + first) / n >= c:
                 m -= 1.0
         counts[int(min(max(m, 0.0), float(n)))] += 1
-    out = np.empty(n, np.int64)
     running = 0
     for k in range(n):
         running += counts[k]
@@ -142,9 +152,8 @@ def _systematic_search(cumulative, first, n):
 
 
 @njit(cache=True)
-def _stratified_uniforms(offsets, n):
-    """(k + U_k) / n for k < n, as numpy's ``(np.arange(n) + U) / n``."""
-    out = np.empty(offsets.size)
+def _stratified_uniforms(offsets, n, out):
+    """(k + U_k) / n for k < n into ``out``, as numpy's ``(np.arange(n) + U) / n``."""
     for k in range(offsets.size):
         out[k] = (k + offsets[k]) / n
     return out
@@ -159,9 +168,8 @@ def _is_sorted(values):
 
 
 @njit(cache=True)
-def _merge_sorted(cumulative, uniforms):
-    """``searchsorted(C, u, side="right")`` for sorted u: one merge pass."""
-    out = np.empty(uniforms.size, np.int64)
+def _merge_sorted(cumulative, uniforms, out):
+    """``searchsorted(C, u, side="right")`` for sorted u into ``out``: one merge pass."""
     i = 0
     for k in range(uniforms.size):
         while i < cumulative.size and cumulative[i] <= uniforms[k]:
@@ -178,21 +186,21 @@ def multinomial(weights: np.ndarray, rng: np.random.Generator, size: int | None 
 def stratified(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """One uniform in each stratum ``[k/N, (k+1)/N)`` (Kitagawa, 1996)."""
     n = len(weights)
-    cumulative, searchable = _cumulative(np.ascontiguousarray(weights, dtype=float))
-    uniforms = _stratified_uniforms(rng.random(n), n)
+    cumulative, searchable = _cumulative(weights)
+    uniforms = _stratified_uniforms(rng.random(n), n, np.empty(n))
     if not searchable or not _is_sorted(uniforms):
         return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
-    return _merge_sorted(cumulative, uniforms)
+    return _merge_sorted(cumulative, uniforms, np.empty(n, np.int64))
 
 
 def systematic(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """A single uniform shared by all strata: ``u_k = (k + U) / N`` (Carpenter et al., 1999)."""
     n = len(weights)
-    cumulative, searchable = _cumulative(np.ascontiguousarray(weights, dtype=float))
+    cumulative, searchable = _cumulative(weights)
     first = rng.random()
     if not searchable:
         return np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right").astype(np.int64)
-    return _systematic_search(cumulative, first, n)
+    return _systematic_search(cumulative, first, np.empty(n + 1, np.int64), np.empty(n, np.int64))
 
 
 def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from replication.compiled import elementwise
 from replication.errors import NotFinite
 
 
@@ -54,5 +55,10 @@ def weighted_mean(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
 
 def weighted_variance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Per-coordinate weighted variance ``sum W_i (x_i - mean)^2``."""
-    centred = particles - weighted_mean(particles, weights)
-    return weights @ centred**2
+    return weights @ _squared_deviation(particles, weighted_mean(particles, weights))
+
+
+@elementwise("float64(float64, float64)")
+def _squared_deviation(x, mean):
+    """(x - mean)^2 in one pass, as numpy's ``(x - mean)**2`` (a square is x * x)."""
+    return (x - mean) * (x - mean)
