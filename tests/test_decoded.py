@@ -10,12 +10,13 @@ from replication.vision.histogram import hsv_bin_image
 
 @pytest.fixture
 def frames(tmp_path, monkeypatch):
-    monkeypatch.setattr(module, "_kept", type(module._kept)())
+    monkeypatch.setattr(module, "_kept", {})
     monkeypatch.setattr(module, "_size", [0])
     rng = np.random.default_rng(0)
     paths = []
-    for k in range(3):
-        paths.append(tmp_path / f"{k}.png")
+    for folder in ("one", "one", "one", "two"):
+        (tmp_path / folder).mkdir(exist_ok=True)
+        paths.append(tmp_path / folder / f"{len(paths)}.png")
         cv2.imwrite(str(paths[-1]), rng.integers(0, 256, (20, 30, 3), dtype=np.uint8))
     return paths
 
@@ -28,13 +29,15 @@ def test_a_frame_is_decoded_once_read_only_and_as_imread_gives_it(frames):
         first[0, 0, 0] = 1  # no run can change what the next one reads
 
 
-def test_the_least_recently_read_frame_goes_first_past_the_budget(frames, monkeypatch):
+def test_one_sequence_is_kept_up_to_the_budget_and_another_drops_it(frames, monkeypatch):
     monkeypatch.setattr(module, "BUDGET_BYTES", 2 * 20 * 30 * 3)  # two frames
-    a, b = module.decoded(frames[0]), module.decoded(frames[1])
-    module.decoded(frames[0])  # a read again: b is now the oldest
-    module.decoded(frames[2])
-    assert list(module._kept) == [frames[0], frames[2]] and module._size[0] == 2 * a.nbytes
-    assert module.decoded(frames[1]) is not b and np.array_equal(module.decoded(frames[1]), b)
+    a, b, c = (module.decoded(path) for path in frames[:3])
+    assert list(module._kept) == frames[:2] and module._size[0] == 2 * a.nbytes  # the third is past the budget
+    assert module.decoded(frames[0]) is a and module.decoded(frames[2]) is not c
+    np.testing.assert_array_equal(module.decoded(frames[2]), c)
+    module.decoded(frames[3])  # another folder: the first sequence's frames go
+    assert list(module._kept) == [frames[3]] and module._size[0] == a.nbytes
+    assert module.decoded(frames[0]) is not a and np.array_equal(module.decoded(frames[0]), a)
     with pytest.raises(OSError, match="cannot read"):
         module.decoded(frames[0].with_name("absent.png"))
 
