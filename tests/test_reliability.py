@@ -397,3 +397,30 @@ def test_every_shipped_experiment_passes_the_checks(make_cfg):
         assert runs and settings == ("loky", 2, None)
     assert prepare(make_cfg("hspf_ungm", *SMALL, "parallel.backend=threading"))[2] == ("threading", 2, None)
 
+
+
+GRID_RUN = """
+from hydra import compose, initialize_config_dir
+from replication.paths import CONF_DIR
+from replication.runner.config import expand
+from replication.runner.execute import perform
+with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+    cfg = compose("config", overrides=["experiment=ungm_horizon", "scale=paper"])
+run = [r for r in expand(cfg) if r.method == "grid" and "T=100" in str(r.condition) and r.repetition == 74][0]
+print(perform(run)["rmse"].hex())
+"""
+
+
+@pytest.mark.e2e
+def test_a_run_gives_the_same_bits_whatever_blas_threads_its_process_has():
+    """The grid filter's products at T = 100 are big enough for OpenBLAS to split them between threads,
+    which sums them in another order: a run computed in the main process (n_jobs=1, every core) gave
+    another last bit than in a one-thread worker until perform set one BLAS thread wherever it runs."""
+    results = set()
+    for threads in ("1", "2"):
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+        done = subprocess.run([sys.executable, "-c", GRID_RUN], capture_output=True, text=True, env=env,
+                              cwd=PROJECT_ROOT, timeout=300)
+        assert done.returncode == 0, done.stderr
+        results.add(done.stdout.split()[-1])
+    assert len(results) == 1, results

@@ -35,7 +35,7 @@ from replication.errors import NotFinite
 from replication.run import Run
 from replication.runner.failures import failure
 from replication.runner.lifeline import watch_parent
-from replication.runner.memory import retain_freed_memory
+from replication.runner.memory import one_blas_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
 from replication.tasks import TASKS
@@ -58,6 +58,7 @@ def perform(run: Run) -> dict:
     """One run: a pure function of the run's identity, parameters and seed.  Its record, or, when a
     number it needs or gives is not finite, only its run id and the reason (``failure``, :mod:`.failures`)."""
     retain_freed_memory()  # in whichever process computes it: a worker of any backend
+    one_blas_thread()
     started = time.perf_counter()
     try:
         metrics = TASKS[run.task].run(run)

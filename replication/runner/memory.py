@@ -1,4 +1,6 @@
-"""Keep freed memory in the process instead of handing it back to the OS at every ``free``.
+"""How a process that computes runs is set up: freed memory kept for reuse, and one BLAS thread.
+
+Keep freed memory in the process instead of handing it back to the OS at every ``free``.
 
 A filter step allocates the same large temporaries every frame (an (N, B + 1)
 count table per likelihood call, an N x N potential table per MRF pair).
@@ -16,6 +18,8 @@ import ctypes
 import ctypes.util
 from functools import cache
 
+from threadpoolctl import threadpool_limits
+
 M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # glibc's <malloc.h>
 MMAP_THRESHOLD = 32 * 2**20  # glibc's maximum on 64-bit: blocks above it still get their own mapping
 TRIM_THRESHOLD = 64 * 2**20  # at most this much free memory is kept at the heap's top (loky restarts a worker grown by 300 MB)
@@ -30,3 +34,15 @@ def retain_freed_memory() -> bool:
     except (OSError, AttributeError, TypeError):  # not glibc (macOS, musl without mallopt, Windows)
         return False
     return bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+
+
+@cache
+def one_blas_thread() -> None:
+    """Every run computes its matrix products with one BLAS thread, in whichever process computes it.
+
+    loky's workers get one thread each (two cores, two jobs), but a run computed in the main process
+    (``n_jobs=1``) had every core: OpenBLAS then splits a product differently and the sums come out in
+    another order, so the grid filter's RMSE at T = 100 differed in its last bit between one job and two
+    (5.902905369091446 against ...445, one run of ungm_horizon's 1500).  The limit stays on for the
+    process (once is enough; the libraries are loaded by then)."""
+    threadpool_limits(limits=1, user_api="blas")
