@@ -24,14 +24,16 @@ from replication.runner.config import expand  # noqa: E402
 from replication.runner.execute import perform  # noqa: E402
 
 PARTS = {"replication/": "replication", "numpy": "numpy", "pandas/": "pandas", "scipy/": "scipy",
-         "numba/": "numba", "llvmlite/": "numba", "cv2": "OpenCV", "{imread}": "OpenCV", "{imdecode}": "OpenCV",
-         "{cvtColor}": "OpenCV", "{LUT}": "OpenCV", "{transform}": "OpenCV", "trackeval/": "TrackEval"}
+         "numba/": "numba", "llvmlite/": "numba", "cv2": "OpenCV", "trackeval/": "TrackEval"}
+OPENCV = {"<imread>", "<imdecode>", "<cvtColor>", "<LUT>", "<transform>", "<resize>", "<calcHist>"}  # cProfile's names
 
 
 def part(filename: str, function: str) -> str:
     """Which library a profiled function belongs to: by its file, or for a built-in (file ``~``: numpy's
     ufunc methods, OpenCV's functions) by its name; ``Python`` for the interpreter and the rest."""
-    where = f"{{{function}}}" if filename == "~" else filename
+    if filename == "~" and function in OPENCV:
+        return "OpenCV"
+    where = function if filename == "~" else filename
     return next((name for key, name in PARTS.items() if key in where), "Python")
 
 

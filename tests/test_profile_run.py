@@ -27,3 +27,16 @@ def test_a_request_matching_no_run_says_so(tmp_path):
                           capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert done.returncode == 1
     assert done.stderr.strip() == "hspf_ungm at quick scale has no run of 'PF' matching 'N=123456'"
+
+
+def test_profiled_functions_are_put_in_their_library():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("profile_run", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.part("~", "<cvtColor>") == "OpenCV"
+    assert module.part("~", "<method 'reduce' of 'numpy.ufunc' objects>") == "numpy"
+    assert module.part("/x/site-packages/pandas/core/frame.py", "__getitem__") == "pandas"
+    assert module.part("/work/main/replication/smc/loop.py", "weigh") == "replication"
+    assert module.part("~", "<built-in method builtins.len>") == "Python"
