@@ -60,13 +60,18 @@ def _fill_cumulative(weights, out):
 
 def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     """Indices i with ``C_{i-1} <= u < C_i`` for the cumulative weights C (:func:`cumulative_weights`)."""
-    return search(cumulative_weights(weights), np.asarray(uniforms, dtype=float))
+    cumulative, searchable = _cumulative(weights)  # checked as it is made: no second pass to check it
+    return _search(cumulative, uniforms, searchable)
 
 
 def search(cumulative: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     """``np.searchsorted(cumulative, uniforms, side="right")`` as int64, in O(N + K) (:func:`_guided_search`)."""
+    return _search(cumulative, uniforms, bool(len(cumulative)) and _searchable(cumulative))
+
+
+def _search(cumulative: np.ndarray, uniforms: np.ndarray, searchable: bool) -> np.ndarray:
     uniforms = np.ascontiguousarray(uniforms, dtype=float)
-    if uniforms.ndim != 1 or not len(cumulative) or not _searchable(cumulative):
+    if uniforms.ndim != 1 or not searchable:
         return np.searchsorted(cumulative, uniforms, side="right").astype(np.int64)
     return _guided_search(cumulative, uniforms, np.empty(4 * len(cumulative) + 1, np.int64),
                           np.empty(uniforms.size, np.int64))
