@@ -20,7 +20,6 @@ import numpy as np
 
 BUDGET_BYTES = 3 * 2**29  # 1.5 GiB of decoded frames (their bin images add two thirds): PETS09-S2L1's 795 are 1.05 GB
 _kept: dict = {}  # path -> its decoded frame, every path in one folder
-_size = [0]
 
 
 def decoded(path: Path) -> np.ndarray:
@@ -34,8 +33,6 @@ def decoded(path: Path) -> np.ndarray:
     image.flags.writeable = False
     if _kept and next(iter(_kept)).parent != path.parent:  # another sequence: drop the last one's frames
         _kept.clear()
-        _size[0] = 0
-    if _size[0] + image.nbytes <= BUDGET_BYTES:
+    if sum(kept.nbytes for kept in _kept.values()) + image.nbytes <= BUDGET_BYTES:
         _kept[path] = image
-        _size[0] += image.nbytes
     return image
