@@ -7,6 +7,8 @@
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
+# make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does)
+# make verify      re-compute N (200) recorded runs here and compare them with the record; N=all for every one
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -14,6 +16,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 SCALE ?= quick
 JOBS ?= 2
+N ?= 200
 EXPERIMENTS := $(sort $(basename $(notdir $(wildcard conf/experiment/*.yaml))))
 READINGS := $(sort $(basename $(notdir $(wildcard conf/experiment/*_readings.yaml))))
 # The multiverses run with make replicate at the quick scale (a small design each); at paper scale
@@ -23,7 +26,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate
+.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate record verify
 
 setup: $(VENV)/.installed
 
@@ -55,8 +58,14 @@ test-all: setup browser
 
 # One Hydra multirun over every experiment: one process and one pool of workers for all of them,
 # instead of starting Python, numba and the workers again per experiment (about two minutes at quick scale).
+# The shipped record's pages first (the verdicts at the papers' scale, in about a minute), then this
+# machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the
+# record is rewritten from the runs just made (a file whose runs did not change keeps its bytes).
 replicate: setup
+	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
+	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python -m replication report source=record pdf=false)
+	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
 	$(BIN)/python -m replication.report.pages.calibration
 	$(BIN)/python -m replication.report.pdf
@@ -64,6 +73,13 @@ replicate: setup
 readings: setup
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(READINGS)) scale=$(SCALE) n_jobs=$(JOBS)
 	$(BIN)/python -m replication.report.pdf
+
+record: setup
+	$(BIN)/python -m replication record
+	$(BIN)/python -m replication report source=record pdf=false
+
+verify: setup
+	$(BIN)/python -m replication verify N=$(N) n_jobs=$(JOBS)
 
 benchmark: setup
 	$(BIN)/python benchmarks/benchmark.py --instructions

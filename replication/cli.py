@@ -1,9 +1,13 @@
-"""``pf-replicate [run|report|scenes|export] key=value ...`` (or ``python -m replication``): the one entry point.
+"""``pf-replicate [run|report|scenes|export|record|verify|diff] key=value ...`` (or ``python -m replication``): the one
+entry point.
 
 ``run`` (the default) checks the request, runs what is missing and writes the experiment's report;
 ``report`` redraws reports from stored runs (:mod:`replication.report.__main__`); ``scenes`` writes
 an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`); ``export`` writes a
-tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod:`replication.export`).
+tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod:`replication.export`);
+``record`` writes the paper-scale record from the store and ``verify`` re-computes a sample of it
+(:mod:`replication.record`); ``diff A B`` lists the claims and cells whose verdict or estimate differ
+between two records or reports (:mod:`replication.report.diff`).
 
 Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
@@ -43,6 +47,9 @@ SUBCOMMANDS = {
     "report": "replication.report.__main__:main",
     "scenes": "replication.scenes.__main__:main",
     "export": "replication.export:main",
+    "record": "replication.record.__main__:main",
+    "verify": "replication.record.verify:main",
+    "diff": "replication.report.diff:main",
 }
 
 

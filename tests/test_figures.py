@@ -14,8 +14,9 @@ from replication.paths import CONF_DIR, resolve
 from replication.report import figures
 from replication.report.figures import metric as metric_figures, tracking as tracking_figures
 from replication.evidence.published import load_published
+from replication.evidence.curves import clip_diverged
 from replication.report.figures.style import (
-    METHODS, PALETTE, NothingToDraw, axis_label, clip_diverged, method_look,
+    METHODS, PALETTE, NothingToDraw, axis_label, method_look,
 )
 
 PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
@@ -192,9 +193,11 @@ def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypa
     records = typed(pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]}))
     with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
         figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")
-    no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0]}))  # no 3123 scene run
-    with pytest.raises(NothingToDraw, match="no run recorded a strip"):
+    no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0], "strip": [None]}))
+    with pytest.raises(NothingToDraw, match="no run recorded a strip"):  # no run on the 3123 scene
         tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
+    with pytest.raises(NothingToDraw, match="drawn from each run's strip, per_frame, which these records do not"):
+        figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png")
     seen = []
     monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
     figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")
@@ -212,8 +215,11 @@ def test_the_encounter_strip_marks_a_swap_where_the_per_identity_error_jumps(dra
     truth[:, 0, 0], truth[:, 1, 0], truth[..., 1] = frames * 3.0, 90 - frames * 3.0, 50
     swapped = truth.copy()
     swapped[16:] = truth[16:, ::-1]
-    monkeypatch.setattr(tracking_figures, "sequence_seen",
-                        lambda experiment, runs: SimpleNamespace(truth=truth, size=(200, 100)))
+    from replication.evidence import curves
+
+    seen = lambda experiment, runs: SimpleNamespace(truth=truth, size=(200, 100))  # noqa: E731
+    monkeypatch.setattr(tracking_figures, "sequence_seen", seen)
+    monkeypatch.setattr(curves, "sequence_seen", seen)  # the off-image curve's table
     records = typed(pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": 0,
                                    "per_frame": {"box": boxes.tolist(), "targets": [0, 1]}}
                                   for m, boxes in (("A", swapped), ("B", truth))]))

@@ -27,6 +27,16 @@ def test_evidence_imports_nothing_above_it():
         assert not upward, (path.name, upward)
 
 
+def test_the_record_imports_nothing_above_it():
+    """The paper-scale record reads the runner's runs and the tables' needs; the report draws it, not the
+    other way round."""
+    files = sorted((PACKAGE_DIR / "record").rglob("*.py"))
+    assert len(files) >= 5
+    for path in files:
+        upward = {name for name in _imports(path) if name.startswith(("replication.report", "replication.cli"))}
+        assert not upward, (path.name, upward)
+
+
 def test_a_run_is_keyed_by_the_code_it_runs(tmp_path):
     """A change of a verdict rule or a drawing computes no run anew; a change of one filter recomputes the
     runs of that filter (and of the filters built on it) and no other."""
@@ -45,7 +55,8 @@ def test_a_run_is_keyed_by_the_code_it_runs(tmp_path):
         return {pair: digest(entries, package) for pair, entries in pairs.items()}
 
     before = keys()
-    for edited in ("evidence/verdict.py", "evidence/tables/table.py", "report/pages/render.py", "cli.py"):
+    for edited in ("evidence/verdict.py", "evidence/tables/table.py", "report/pages/render.py", "cli.py",
+                   "record/runs.py"):
         (package / edited).write_text((package / edited).read_text() + "\n# a new rule\n")
         assert keys() == before, edited
     (package / "filters/harmony.py").write_text((package / "filters/harmony.py").read_text() + "\n# x\n")

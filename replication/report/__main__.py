@@ -1,5 +1,10 @@
-"""``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true]``:
+"""``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true] [source=record]``:
 rebuild reports from stored runs only.
+
+``source=record`` draws the paper-scale record's reports instead (:mod:`replication.record`: every
+experiment it holds, at the paper scale, into ``<reports>/record/``): tables, verdicts and the figures
+drawn from runs' metrics; a figure drawn from per-frame series the record does not keep is left out, and
+its page says so.
 
 ``python -m replication.report experiment=<name> sweep=<key>=v1,v2,... [metric=<column>]``
 instead draws a Hydra multirun's sweep of one config value (``replication.report.pages.sweep``).
@@ -12,15 +17,19 @@ view of the index as ``reports/screenshot.png`` (where Chromium is installed).
 """
 
 import sys
+from pathlib import Path
 
 from hydra import compose, initialize_config_dir
 
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.record.manifest import PAGES, Manifest
+from replication.record.runs import Record
 from replication.report.pages.experiment import write_experiment_report
 from replication.report.pages.index import write_index
 from replication.report.pages.multiverse import write_multiverse_report
+from replication.report.pages.recorded import write_status
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
@@ -28,7 +37,8 @@ from replication.runner.results import Results
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
-OPTIONS = ("sweep", "metric")  # ours too: name=text
+OPTIONS = ("sweep", "metric", "source")  # ours too: name=text
+SOURCES = ("store", "record")
 
 
 def main(argv: list[str]) -> None:
@@ -55,6 +65,12 @@ def main(argv: list[str]) -> None:
         return report_sweep(names[0], options["sweep"], options.get("metric"), overrides)
     if "metric" in options:
         fail("metric= only goes with sweep=")
+    source = options.get("source", "store")
+    if source not in SOURCES:
+        fail(f"source must be one of {', '.join(SOURCES)}, got {source!r}")
+    if source == "record":
+        names, overrides = recorded_experiments(names, overrides, bool(chosen))
+    stale = {}  # drawn from the record: per experiment, its recorded runs that other code made
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         for name in names:
             try:
@@ -67,15 +83,28 @@ def main(argv: list[str]) -> None:
             cfg = compose("config", overrides=[f"experiment={name}", *overrides])
             try:
                 configure(cfg.inference)
-                if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
+                if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
+                    multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
+                    page = write_multiverse_report(cfg, multiverse, tuple(overrides),
+                                                   lambda name, u: record.universe(multiverse.name, u.name))
+                    stale[name] = sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
+                                      for u in multiverse.universes for e in multiverse.experiments)
+                elif "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
                     page = write_multiverse_report(cfg, load_multiverse(cfg), tuple(overrides))
                 else:
-                    results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
+                    if source == "record":
+                        store = Record(resolve(cfg.record))
+                        results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
+                        stale[name] = len(store.stale(results.runs))
+                    else:
+                        results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
                     page = write_experiment_report(cfg, results)
             except ConfigError as error:
                 fail(str(error))
             print(f"{name}: {page}")
         reports = resolve(cfg.reports)
+        if source == "record":
+            print(f"status: {write_status(reports, Manifest.read(resolve(cfg.record)), stale)}")
         if switches["pdf"]:
             from replication.report.pdf import write_pdf
 
@@ -93,6 +122,22 @@ def main(argv: list[str]) -> None:
                 print(f"screenshot: {seen['screenshot']}")
                 for line in seen["console"]:
                     print(f"console: {line}", file=sys.stderr)
+
+
+def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -> tuple[list[str], list[str]]:
+    """The experiments to draw from the record (those it holds, of ``names``) and the overrides that draw
+    them: the paper scale, into ``<reports>/record``."""
+    from omegaconf import OmegaConf
+
+    settings = {**OmegaConf.load(CONF_DIR / "config.yaml"), **dict(o.partition("=")[::2] for o in overrides)}
+    held = Manifest.read(resolve(settings["record"])).experiments
+    if not held:
+        fail(f"{resolve(settings['record'])}: no record here (make record writes one from a paper-scale store)")
+    if chosen and set(names) - set(held):
+        fail(f"the record holds no {sorted(set(names) - set(held))[0]!r}; it holds {', '.join(sorted(held))}")
+    reports = Path(settings["reports"]) / PAGES
+    kept = [o for o in overrides if o.partition("=")[0] not in ("scale", "reports")]
+    return [name for name in names if name in held], [*kept, "scale=paper", f"reports={reports}"]
 
 
 def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]) -> None:

@@ -28,7 +28,7 @@ its runs, their stored records and the failures' reasons), which also writes bot
 
 import json
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -45,6 +45,7 @@ from replication.runner.variant import differences, report_name
 from replication.tasks import TASKS
 
 SERIES = ("per_frame", "strip", "tracks")  # per-frame data, kept in the records
+FRAME_SERIES = ("per_frame", "tracks")  # what the tasks' frame_table read
 IDENTITY = ("experiment", "method", "condition", "repetition", "run_key")
 
 
@@ -60,15 +61,18 @@ class Results:
     name: str  # the report's: the experiment's, or ``<experiment>@<label>`` for a user's own data or settings
     changes: tuple[str, ...] = ()  # what the request changed in the shipped experiment (runner.variant)
     command: str = ""  # the command line that made these results
+    curves: dict[str, pd.DataFrame] = field(default_factory=dict)  # figure -> its curve table, where kept (record)
 
     @classmethod
-    def of(cls, cfg: DictConfig, runs: list[Run], store: Store, overrides: tuple[str, ...] = ()) -> "Results":
-        """The stored results of ``runs``; ``overrides``: the request's command-line settings (for the page)."""
+    def of(cls, cfg: DictConfig, runs: list[Run], store: Store, overrides: tuple[str, ...] = (),
+           curves: dict[str, pd.DataFrame] | None = None) -> "Results":
+        """The stored results of ``runs``; ``overrides``: the request's command-line settings (for the page);
+        ``curves``: the curve figures' tables where the runs' series are not at hand (the record's)."""
         changes = differences(cfg)
         command = " ".join(["python -m replication", f"experiment={cfg.experiment.name}", f"scale={cfg.scale}",
                             *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])
         return cls(experiment_at_scale(cfg), runs, store.load(runs), store.failures(runs),
-                   report_name(cfg, changes), tuple(changes), command)
+                   report_name(cfg, changes), tuple(changes), command, curves or {})
 
     @property
     def own(self) -> bool:
@@ -108,7 +112,10 @@ def tidy(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
 
 def frames(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
     """The per-frame rows of the ``records`` of ``runs``, each with its run's identity; empty for a
-    task without per-frame data (``scalar``)."""
+    task without per-frame data (``scalar``), and for records without their series (the paper-scale
+    record's, :mod:`replication.record`)."""
+    if not any(series in records for series in FRAME_SERIES):
+        return pd.DataFrame()
     by_id = {run.run_id: run for run in runs}
     tables = []
     for record in records.to_dict("records"):

@@ -53,6 +53,7 @@ class Modes(TableKind):
     """Does a hidden target's posterior keep both hypotheses?  Runs that do, per method (bis_pf's 3123 text)."""
 
     kind = "modes"
+    reads = ("strip",)
     BANDS = {"success": (0.5, 1.0), "failure": (0.0, 0.5)}  # most runs keep both modes, or most do not
 
     def build(self, records: pd.DataFrame) -> Table:

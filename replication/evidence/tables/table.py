@@ -144,6 +144,7 @@ class TableKind:
 
     kind: ClassVar[str]
     compares: ClassVar[bool] = True  # whether its rows are matched with published cells
+    reads: ClassVar[tuple[str, ...]] = ()  # the per-frame series of a run it is built from (the record keeps them)
     registry: ClassVar[dict[str, type["TableKind"]]] = {}
 
     def __init_subclass__(cls, **kwargs):

@@ -1,42 +1,56 @@
 """A figure kind: a function of (records, spec, experiment, path) registered under the name a spec's ``kind:``
-gives it, and :func:`draw`, the one way a page draws a figure."""
+gives it, with the per-frame series of a run it reads, and :func:`draw`, the one way a page draws a figure."""
 
 from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
 
+from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.published import COLUMNS
 from replication.report.figures.style import NothingToDraw
 
 KINDS: dict[str, Callable[..., Path]] = {}
+READS: dict[str, tuple[str, ...]] = {}  # kind -> the record columns of per-frame series it draws from
 
 
-def figure(kind: str) -> Callable:
-    """Register the decorated function as the figure kind ``kind``."""
+def figure(kind: str, reads: tuple[str, ...] = ()) -> Callable:
+    """Register the decorated function as the figure kind ``kind``, drawn from the series ``reads``
+    (``per_frame``, ``tracks``, ``strip``) of each run besides its metrics."""
     def register(draw_kind: Callable[..., Path]) -> Callable[..., Path]:
-        KINDS[kind] = draw_kind
+        KINDS[kind], READS[kind] = draw_kind, reads
         return draw_kind
     return register
 
 
 def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
-         published: pd.DataFrame | None = None) -> Path:
+         published: pd.DataFrame | None = None, curve: pd.DataFrame | None = None) -> Path:
     """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
 
     A spec that names a ``paper_table`` gets the published values ``published``: the file the report was
     asked to judge against, passed down once (none: no paper values on the figure).
     A spec with ``conditions: [..]`` draws the runs of those conditions only.
+    A kind that draws a curve table (:data:`~replication.evidence.curves.CURVES`) draws ``curve`` where it
+    is given (the paper-scale record keeps the table, not the runs' series), else the table of ``records``.
     """
-    if spec["kind"] not in KINDS:
-        raise ValueError(f"unknown figure kind {spec['kind']!r}; choose one of {sorted(KINDS)}")
-    if "conditions" in spec:
-        records = records[records["condition"].isin(spec["conditions"])]
-        if records.empty:  # a scene the figure needs was not run (dropped by an override, say)
-            raise NothingToDraw(f"figure {spec.get('name', spec['kind'])!r}: no runs at conditions "
-                                f"{spec['conditions']}")
+    kind = spec["kind"]
+    if kind not in KINDS:
+        raise ValueError(f"unknown figure kind {kind!r}; choose one of {sorted(KINDS)}")
+    if curve is None:
+        absent = [series for series in READS.get(kind, ()) if series not in records]
+        if absent:  # runs read from the paper-scale record, which keeps no per-frame series a table does not need
+            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: drawn from each run's {', '.join(absent)}, "
+                                "which these records do not hold")
+        if "conditions" in spec and not records["condition"].isin(spec["conditions"]).any():
+            # a scene the figure needs was not run (dropped by an override, say)
+            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: no runs at conditions {spec['conditions']}")
+        if kind in CURVES:
+            curve = curve_table(records, spec, experiment)
+        elif "conditions" in spec:
+            records = records[records["condition"].isin(spec["conditions"])]
+    drawn = curve if kind in CURVES else records
     if "paper_table" not in spec:
-        return KINDS[spec["kind"]](records, spec, experiment, path)
+        return KINDS[kind](drawn, spec, experiment, path)
     if published is None:
         published = pd.DataFrame(columns=COLUMNS + ["number"])
-    return KINDS[spec["kind"]](records, spec, experiment, path, published=published)
+    return KINDS[kind](drawn, spec, experiment, path, published=published)

@@ -16,8 +16,9 @@ from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from replication.condition import label_of, values_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.published import cells  # noqa: E402
+from replication.evidence.curves import clip_diverged, clip_level  # noqa: E402
 from replication.report.figures.style import (  # noqa: E402
-    BLACK, PAPER, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+    BLACK, PAPER, axis_label, clipped_note, method_label, method_look, save,
     shades,
 )
 from replication.report.figures.base import figure  # noqa: E402

@@ -130,7 +130,7 @@ CAPTION = ("Coloured boxes: the tracker's output, one colour per track id (its n
            "white: ground truth; dashed grey: regions MOTChallenge ignores.")
 
 
-@figure("track_snapshots")
+@figure("track_snapshots", reads=("tracks",))
 def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Frames of the real video with each method's output (its first run), one row per method and condition,
     one column per frame of ``spec.frames`` (``{<scene key>: [MOT frame numbers]}`` or one list for every
@@ -189,7 +189,7 @@ def timeline_matches(sequence: MotSequence, run) -> tuple[pd.DataFrame, pd.DataF
     return truth, matches
 
 
-@figure("identity_timeline")
+@figure("identity_timeline", reads=("tracks",))
 def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Which output track held which person, frame by frame: one panel per method (its first run) and
     condition, one lane per ground-truth id, a bar in the matched track's colour (its id written in it)
@@ -317,7 +317,7 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
     return path
 
 
-@figure("track_video")
+@figure("track_video", reads=("tracks",))
 def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """An animated GIF of one run, and a PNG poster as the figure: its first frame with an output box.
 

@@ -174,27 +174,6 @@ def axis_label(name: str) -> str:
     return LABELS[base].format(rule=LABELS.get(rule, rule)) if base in LABELS else name
 
 
-def clip_level(spec: dict, typical: float) -> float | None:
-    """Where a diverged run is cut: the figure's ``clip:``, else 10 times the typical magnitude given
-    (none when that is 0 or unknown)."""
-    if spec.get("clip") is not None:
-        return float(spec["clip"])
-    level = 10 * abs(typical)
-    return level if np.isfinite(level) and level > 0 else None
-
-
-def clip_diverged(values, level: float | None) -> tuple[np.ndarray, np.ndarray]:
-    """``values`` (one per run, or runs x frames) with each non-finite one or one beyond ``level`` in
-    size put at the level (left out where there is none); and which runs diverged so."""
-    values = np.asarray(values, dtype=float)
-    bad = ~np.isfinite(values)
-    if level is not None:
-        bad |= np.abs(values) > level
-    edge = np.sign(np.nan_to_num(values, nan=1.0)) * (np.nan if level is None else level)
-    diverged = bad if values.ndim == 1 else bad.any(axis=1)
-    return np.where(bad, edge, values), diverged
-
-
 def clipped_note(diverged: int, runs: int) -> str:
     """What a legend says of the diverged runs of a line (nothing when none did)."""
     return f" ({diverged} of {runs} runs diverged, clipped)" if diverged else ""

@@ -11,9 +11,9 @@ from matplotlib.colors import to_rgb
 from replication.evidence.aggregate import scene_of, sequence_seen
 from replication.evidence.attributes import absent, attribute_scores
 from replication.metrics import multi
-from replication.metrics.tracking import centres, outside_image
+from replication.metrics.tracking import centres
 from replication.report.figures.style import (
-    NothingToDraw, axis_label, clip_diverged, clip_level, clipped_note, method_label, method_look, save,
+    NothingToDraw, axis_label, clipped_note, method_label, method_look, save,
 )
 from replication.report.figures.base import figure
 
@@ -22,10 +22,10 @@ def _by_condition(records: pd.DataFrame):
     return list(records.groupby("condition", sort=False))
 
 
-@figure("per_frame_curve")
-def per_frame_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
-    """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition;
-    methods that do not record the series are left out.
+@figure("per_frame_curve", reads=("per_frame",))
+def per_frame_curve(bands: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+    """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition
+    (:func:`~replication.evidence.curves.per_frame_band`); methods that do not record the series are left out.
 
     A run diverged where it is not finite or beyond ``spec.clip`` (by default 10
     times the largest median over runs of any method at any frame, in size: a
@@ -34,41 +34,22 @@ def per_frame_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     does not flatten every other curve, and the method's label says how many
     runs did.
     """
-    groups = _by_condition(records)
+    groups = list(bands.groupby("condition", sort=False))
     fig, axes = plt.subplots(len(groups), 1, figsize=(7, 2.6 * len(groups)), squeeze=False)
     for ax, (condition, group) in zip(axes[:, 0], groups):
-        curves = _per_frame(group, spec["series"])
-        typical = max((np.nanmax(np.nanmedian(np.abs(v), axis=0)) for _, v in curves.values()),
-                      default=np.nan)
-        level = clip_level(spec, typical)
-        for method, (frames, values) in curves.items():
-            values, diverged = clip_diverged(values, level)
-            look = method_look(method)
-            ax.plot(frames, np.nanmean(values, axis=0), **look.line(), markevery=max(1, len(frames) // 12),
+        for method, band in group.groupby("method", sort=False):
+            frames, look = band["frame"].to_numpy(), method_look(method)
+            ax.plot(frames, band["mean"], **look.line(), markevery=max(1, len(frames) // 12),
                     markersize=4, lw=1.2,
-                    label=method_label(experiment, method) + clipped_note(diverged.sum(), len(diverged)))
-            low, high = np.nanpercentile(values, [10, 90], axis=0)
-            ax.fill_between(frames, low, high, color=look.colour, alpha=0.15)
+                    label=method_label(experiment, method)
+                    + clipped_note(band["diverged"].iloc[0], band["runs"].iloc[0]))
+            ax.fill_between(frames, band["low"], band["high"], color=look.colour, alpha=0.15)
         ax.set_title(condition, fontsize=9)
         ax.set_ylabel(spec.get("ylabel") or axis_label(spec["series"]))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     axes[-1, 0].set_xlabel("frame")
     return save(fig, path)
-
-
-def _per_frame(group: pd.DataFrame, series: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each method's frames (1-based) and runs x frames values of a per-frame series, without the frames
-    no run estimates (the given first one); methods that do not record it (alpha_k: fusion filters
-    only) are left out."""
-    curves = {}
-    for method, runs in group.groupby("method", sort=False):
-        if series not in runs["per_frame"].iloc[0]:
-            continue
-        values = np.array([r[series] for r in runs["per_frame"]], dtype=float)
-        kept = ~np.isnan(values).all(axis=0)
-        curves[method] = (np.arange(1, values.shape[1] + 1)[kept], values[:, kept])
-    return curves
 
 
 def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
@@ -80,7 +61,7 @@ def _sequence(experiment: dict, condition_records: pd.DataFrame):
     return sequence_seen(experiment, condition_records), condition_records["per_frame"].iloc[0]["targets"]
 
 
-@figure("track")
+@figure("track", reads=("per_frame",))
 def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Centre x and y against the frame for the first run of each method, beside the truth."""
     groups = _by_condition(records)
@@ -113,7 +94,7 @@ def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
     return [k for k in frames if k < n_frames]
 
 
-@figure("snapshots")
+@figure("snapshots", reads=("per_frame",))
 def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Snapshot grids, one block per condition; truth white edged in black, each method's first run in
     its colour.
@@ -165,12 +146,11 @@ def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, colour: st
     return image
 
 
-@figure("mode_strip")
+@figure("mode_strip", reads=("strip", "per_frame"))
 def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """The marginal posterior of one target over x or y, frame by frame (first run of each method),
     with every target's true coordinate drawn over it: does a hidden target keep both modes?"""
-    stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
-    runs = list(_first_runs(stripped).iterrows())
+    runs = list(_first_runs(records[records["strip"].notna()]).iterrows())
     if not runs:
         raise NothingToDraw(f"figure {spec.get('name', 'mode_strip')!r}: no run recorded a strip (a scene's "
                             "strip: {target: ...} block, bis_pf's exp1_3123)")
@@ -195,31 +175,22 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     return save(fig, path)
 
 
-@figure("otb_curves")
-def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@figure("otb_curves", reads=("per_frame",))
+def otb_curves(curves: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """OTB one-pass precision and success plots over every sequence and run, one line per method.
 
-    Each curve is the mean over runs of the per-run curve (the frames
-    :func:`~replication.metrics.tracking.scored_frames` counts), so every
-    sequence weighs the same, as in OTB's toolkit; the legend gives precision
-    at 20 px and the success AUC.
+    Each curve is the mean over runs of the per-run curve (:func:`~replication.evidence.curves.otb_curves`),
+    so every sequence weighs the same, as in OTB's toolkit; the legend gives precision at 20 px and the
+    success AUC.
     """
-    from replication.metrics import tracking as tm
-
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
-    for method, runs in records.groupby("method", sort=False):
-        errors = [tm.scored_frames(np.asarray(r["cle"], dtype=float)) for r in runs["per_frame"]]
-        overlaps = [tm.scored_frames(np.asarray(r["iou"], dtype=float)) for r in runs["per_frame"]]
-        precision = np.mean([tm.precision_curve(e) for e in errors], axis=0)
-        success = np.mean([tm.success_curve(o) for o in overlaps], axis=0)
-        label, line = method_label(experiment, method), method_look(method).line()
-        left.plot(tm.PRECISION_THRESHOLDS, precision, **line, markevery=5, markersize=4,
-                  label=f"{label} [{np.mean([tm.precision_at(e) for e in errors]):.3f}]")
-        right.plot(tm.SUCCESS_THRESHOLDS, success, **line, markevery=3, markersize=4,
-                   label=f"{label} [{np.mean([tm.success_auc(o) for o in overlaps]):.3f}]")
-    left.set(xlabel="location error threshold (px)", ylabel="precision", title="Precision plot (OPE)")
-    right.set(xlabel="overlap threshold", ylabel="success rate", title="Success plot (OPE)")
-    for ax in (left, right):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for ax, name, every in ((axes[0], "precision", 5), (axes[1], "success", 3)):
+        for method, line in curves[curves["curve"] == name].groupby("method", sort=False):
+            ax.plot(line["threshold"], line["value"], **method_look(method).line(), markevery=every, markersize=4,
+                    label=f"{method_label(experiment, method)} [{line['score'].iloc[0]:.3f}]")
+    axes[0].set(xlabel="location error threshold (px)", ylabel="precision", title="Precision plot (OPE)")
+    axes[1].set(xlabel="overlap threshold", ylabel="success rate", title="Success plot (OPE)")
+    for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     return save(fig, path)
@@ -269,7 +240,7 @@ def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Pat
     return save(fig, path)
 
 
-@figure("encounter_strip")
+@figure("encounter_strip", reads=("per_frame",))
 def encounter_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Why the per-identity error grows, for the first run of each method: above, its per-identity and
     identity-free error per frame; below, one row per pair of targets that comes within ``spec.distance`` px
@@ -312,17 +283,15 @@ def encounter_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     return save(fig, path)
 
 
-@figure("outside_curve")
-def outside_curve(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@figure("outside_curve", reads=("per_frame",))
+def outside_curve(shares: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
     """Per frame, the share of targets whose estimated centre lies outside the image (the filter's own state,
-    never clipped), mean over runs, per method: a tracker that runs off the frame shows it here."""
-    sequence, _ = _sequence(experiment, records)
+    never clipped), mean over runs, per method (:func:`~replication.evidence.curves.outside_share`): a
+    tracker that runs off the frame shows it here."""
     fig, ax = plt.subplots(figsize=(7, 2.8))
-    for method, runs in records.groupby("method", sort=False):
-        outside = outside_image(np.array([r["box"] for r in runs["per_frame"]], dtype=float), sequence.size)
-        ax.plot(np.arange(outside.shape[1]), outside.mean(axis=(0, 2)), **method_look(method).line(),
-                markevery=max(1, outside.shape[1] // 12), markersize=4, lw=1.2,
-                label=method_label(experiment, method))
+    for method, share in shares.groupby("method", sort=False):
+        ax.plot(share["frame"], share["share"], **method_look(method).line(),
+                markevery=max(1, len(share) // 12), markersize=4, lw=1.2, label=method_label(experiment, method))
     ax.set_xlabel("frame")
     ax.set_ylabel("share of estimates\noutside the image")
     ax.grid(True, alpha=0.3)

@@ -39,7 +39,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     tables, figures, built, left_out = [], [], {}, []
     files = results.write_tables(out)
     results_folders = [f"results/{folder}/" for layout, folder in LAYOUTS.items()  # real OTB runs, for the toolkits
-                       if len(records) and write_results(runs, records, out / "results", layout)]
+                       if "per_frame" in records and write_results(runs, records, out / "results", layout)]
     if len(records):
         for table_spec in spec.get("tables", []):
             table = TableKind.of(table_spec, experiment, published).build(records)
@@ -55,7 +55,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
         for figure_spec in spec.get("figures", []):
             file = f"{figure_spec['name']}.png"
             try:
-                draw(records, figure_spec, experiment, out / file, published)
+                draw(records, figure_spec, experiment, out / file, published, results.curves.get(figure_spec["name"]))
             except NothingToDraw as reason:  # as a table none of whose conditions ran: left out, and said
                 left_out.append(str(reason))
                 continue

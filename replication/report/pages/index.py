@@ -15,6 +15,7 @@ import replication
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.evidence.claims import load_papers
 from replication.evidence.published import load_published
+from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
@@ -58,6 +59,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     published = load_published(str(resolve(published_values or default_published_values())))
     papers = load_papers()
     rows = claim_rows(papers, summaries)
+    record = recorded(reports, papers)
     cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
@@ -75,6 +77,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             papers=[{"paper": paper, "claims": rows[paper.key], "tally": tally(rows[paper.key]),
                      "cells": int((cells["paper"] == paper.key).sum())} for paper in papers],
             scale_note=_scale_note(summaries),
+            record=record,
             tallies=tallies,
             rules=rules(),
             counts=counts(cells, summaries),

@@ -31,16 +31,19 @@ from replication.evidence.tables import TableKind
 from replication.runner.multiverse import Multiverse
 from replication.runner.store import Store
 
-def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFrame) -> list[Robustness]:
+def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFrame) -> tuple[list[Robustness], int]:
     """Every claim of the paper tested in every universe with each of its readings on the multiverse's
-    experiments (``store_of(experiment)``: the store its runs are in)."""
+    experiments (``store_of(experiment, universe)``: where that universe's runs of it are); and how many
+    records were read (a run several universes share, in each)."""
     claims = [c for paper in load_papers() if paper.key == multiverse.paper for c in paper.claims]
     cases: dict[str, list[Case]] = {c.id: [] for c in claims}
+    n_records = 0
     for universe in multiverse.universes:
         results = {}
         for name in multiverse.experiments:
             experiment = multiverse.experiment_configs[universe.name, name]
-            records = store_of(name).load(multiverse.runs[universe.name, name])
+            records = store_of(name, universe).load(multiverse.runs[universe.name, name])
+            n_records += len(records)
             tables = _tables(name, experiment, records, claims, published)
             for claim, readings in evaluate(name, experiment, records, tables, published).items():
                 results.setdefault(claim, {}).update(readings)
@@ -50,7 +53,7 @@ def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFram
                 if stored is not None:
                     scoring = ((BASIS, reading.compared_at), (READING, reading.name))
                     cases[claim.id].append(Case(universe.name, universe.picks + scoring, stored))
-    return [Robustness(claim, tuple(cases[claim.id])) for claim in claims if cases[claim.id]]
+    return [Robustness(claim, tuple(cases[claim.id])) for claim in claims if cases[claim.id]], n_records
 
 
 def _tables(name: str, experiment: dict, records: pd.DataFrame, claims: list[Claim], published: pd.DataFrame):
@@ -108,21 +111,22 @@ def _headline(robustness: Robustness) -> str | None:
     return deciding.what if deciding and deciding.estimate is not None else None
 
 
-def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = ()) -> Path:
+def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
+                            store_of=None) -> Path:
     """``<reports>/<paper>_readings/``: the choices, the universes run, each claim's robustness with every
-    case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard."""
+    case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard.  ``store_of(experiment,
+    universe)`` holds the runs (the store by default; the paper-scale record's universe)."""
     out = resolve(cfg.reports) / multiverse.name
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(resolve(cfg.published_values)))
-    robustness = evaluate_multiverse(multiverse, lambda name: Store(resolve(cfg.store), name), published)
+    store_of = store_of or (lambda name, universe: Store(resolve(cfg.store), name))
+    robustness, n_records = evaluate_multiverse(multiverse, store_of, published)
     draw(robustness, multiverse, out / "readings.png")
     frame = pd.DataFrame([{"claim_id": r.claim.id, "universe": c.universe, **{k: v for k, v in c.picks},
                            "verdict": c.verdict.outcome.value, "why": c.verdict.why,
                            "number": c.deciding.number if c.deciding else ""} for r in robustness for c in r.cases])
     frame.to_csv(out / "cases.csv", index=False)
-    runs = {name: multiverse.runs_of(name) for name in multiverse.experiments}
-    n_runs = sum(len(r) for r in runs.values())
-    n_records = sum(Store(resolve(cfg.store), name).path(run).exists() for name, r in runs.items() for run in r)
+    n_runs = sum(len(runs) for runs in multiverse.runs.values())  # per universe: a shared run in each
     page = out / "index.html"
     page.write_text(render(
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,

@@ -1,0 +1,95 @@
+"""``record/manifest.json``: what made the record, and the SHA-256 of each of its files.
+
+One :class:`Entry` per experiment, read off its runs' own provenance: how many runs (and failed), the
+commits and code digests that computed them, the libraries and CPU, when the first and last were
+computed and their summed wall time; and of its files, the SHA-256 of each and their size
+(:meth:`Manifest.damaged` names a file that no longer matches).
+"""
+
+import datetime
+import hashlib
+import json
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+MANIFEST = "manifest.json"
+PAGES = "record"  # <reports>/record/: the record's pages (pf-replicate report source=record)
+RECOMPUTED = "recomputed.json"  # in <reports>/record/: the store's runs that are recorded ones, compared (verify)
+LIBRARIES = ("python_version", "numpy_version", "scipy_version", "opencv_version", "numba_version")
+
+
+@dataclass(frozen=True)
+class Entry:
+    files: dict[str, str]  # path inside the record -> SHA-256: the runs table first, then the curve tables
+    bytes: int
+    runs: int
+    failed: int
+    wall_s: float  # summed over the runs (one core each)
+    first_computed: str | None
+    last_computed: str | None
+    commits: tuple[str, ...]
+    dirty: bool  # a run was computed from a tree with uncommitted changes to the package
+    code_digests: tuple[str, ...]
+    libraries: tuple[str, ...]  # "python 3.11.2, numpy 2.1.3, ..." per distinct set
+    machines: tuple[str, ...]
+    written: str  # the date the file was written
+
+    @classmethod
+    def of(cls, paths: list[Path], record: Path, rows: list[dict]) -> "Entry":
+        computed = sorted(r["computed_at"] for r in rows if r.get("computed_at"))
+        return cls(
+            files={path.relative_to(record).as_posix(): sha256(path) for path in paths},
+            bytes=sum(path.stat().st_size for path in paths),
+            runs=len(rows), failed=sum(1 for r in rows if r.get("failure")),
+            wall_s=round(sum(r.get("wall_s") or 0.0 for r in rows), 1),
+            first_computed=computed[0] if computed else None, last_computed=computed[-1] if computed else None,
+            commits=_distinct(rows, "git_commit"), dirty=any(bool(r.get("git_dirty")) for r in rows),
+            code_digests=_distinct(rows, "code_digest"),
+            libraries=tuple(sorted({", ".join(f"{k.removesuffix('_version')} {r.get(k)}" for k in LIBRARIES)
+                                    for r in rows if not r.get("failure")})),
+            machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat())
+
+
+@dataclass(frozen=True)
+class Manifest:
+    experiments: dict[str, Entry]
+    scale: str = "paper"
+
+    @classmethod
+    def read(cls, record: Path) -> "Manifest":
+        """The record's manifest; an empty one where there is none yet."""
+        path = Path(record) / MANIFEST
+        if not path.exists():
+            return cls({})
+        data = json.loads(path.read_text())
+        entries = {name: Entry(**{k: tuple(v) if isinstance(v, list) else v for k, v in entry.items()})
+                   for name, entry in data["experiments"].items()}  # JSON's lists back to the tuples written
+        return cls(entries, data["scale"])
+
+    def with_entry(self, name: str, entry: Entry) -> "Manifest":
+        """The manifest with ``entry`` for ``name``, unless its file is the same bytes as before (the
+        earlier entry, and its date, stay)."""
+        before = self.experiments.get(name)
+        if before is not None and before.files == entry.files:
+            return self
+        return replace(self, experiments={**self.experiments, name: entry})
+
+    def write(self, record: Path) -> Path:
+        path = Path(record) / MANIFEST
+        path.parent.mkdir(parents=True, exist_ok=True)
+        data = {"scale": self.scale, "experiments": {k: asdict(v) for k, v in sorted(self.experiments.items())}}
+        path.write_text(json.dumps(data, indent=1) + "\n")
+        return path
+
+    def damaged(self, record: Path) -> list[str]:
+        """The files whose bytes no longer have the manifest's SHA-256 (or that are gone)."""
+        return [file for entry in self.experiments.values() for file, digest in entry.files.items()
+                if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _distinct(rows: list[dict], key: str) -> tuple:
+    return tuple(sorted({str(r[key]) for r in rows if r.get(key) is not None}))

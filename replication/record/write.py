@@ -1,0 +1,150 @@
+"""``pf-replicate record [experiment=a,b] [store=...] [record=...]``: write the paper-scale record from the
+store.
+
+Each experiment's runs at the paper scale, as the runner expands them, are read from the store (failed
+runs with their reason) into ``<record>/<experiment>/runs.parquet`` (:mod:`.runs`), and the tables its curve
+figures draw into ``<record>/<experiment>/curves/<figure>.parquet``; a paper's multiverse
+(``<paper>_readings``) universe by universe into ``<record>/<paper>_readings/universes/<universe>.parquet``.  An
+experiment with a run neither stored nor failed is not written (run it first: the record holds whole
+experiments), and the manifest (:mod:`.manifest`) is updated for those written.  A table whose bytes do
+not change keeps its manifest entry, date and commit, so regenerating the record changes only what
+changed.
+"""
+
+import shutil
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+from omegaconf import DictConfig
+
+from replication.errors import ConfigError
+from replication.evidence.curves import CURVES, curve_table
+from replication.evidence.tables import TableKind
+from replication.record.manifest import Entry, Manifest
+from replication.record.runs import (
+    CURVES_DIR, RUNS_FILE, UNIVERSE, read_rows, row, runs_table, universe_path, write_table,
+)
+from replication.run import Run
+from replication.runner.config import expand, experiment_at_scale
+from replication.runner.multiverse import load
+from replication.runner.store import CorruptRecord, Store
+
+SCALE = "paper"
+
+
+def kept_series(experiment: dict) -> tuple[str, ...]:
+    """The per-frame series the experiment's tables are built from: the record keeps those alone."""
+    tables = experiment.get("report", {}).get("tables", [])
+    return tuple(sorted({s for spec in tables for s in TableKind.of(spec, experiment, None).reads}))
+
+
+def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...]) -> tuple[list[dict], int]:
+    """The rows of ``runs`` from ``store`` (a failed run with its reason), and how many it holds neither
+    stored nor failed."""
+    rows, missing = [], 0
+    for run in runs:
+        try:
+            stored = store.read(run)
+        except CorruptRecord:
+            stored = None
+        failed = store.failure_path(run)
+        failure = failed.read_text().strip() if stored is None and failed.exists() else None
+        if stored is None and failure is None:
+            missing += 1
+        else:
+            rows.append(row(run, stored, failure, series))
+    return rows, missing
+
+
+def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
+    """Write ``cfg.experiment``'s runs (``cfg.scale`` must be the paper's) into ``record``, and the tables its
+    curve figures draw; its manifest entry.  Raises :class:`ConfigError` naming how many runs are missing
+    when the store does not hold them all."""
+    name, runs = cfg.experiment.name, expand(_at_paper_scale(cfg))
+    experiment, store = experiment_at_scale(cfg), Store(store_root, cfg.experiment.name)
+    rows, missing = stored_rows(runs, store, kept_series(experiment))
+    _complete(name, missing, len(runs))
+    path = record / name / RUNS_FILE
+    write_table(runs_table(rows), path)
+    return Entry.of([path, *write_curves(experiment, store.load(runs), record / name / CURVES_DIR)], record, rows)
+
+
+def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
+    """Write each universe of a paper's multiverse whose runs the store holds into its own file (a row per
+    run of each experiment it re-runs, its picks as ``universe.<choice>`` columns), so that a multiverse
+    too long for one sitting is recorded universe by universe; the others are left as they are (a file
+    written before stays), with one line each.  Its manifest entry: every universe file there is."""
+    multiverse = load(_at_paper_scale(cfg))
+    kept = set()
+    for universe in multiverse.universes:
+        path = universe_path(record, multiverse.name, universe.name)
+        kept.add(path)
+        picks = {f"{UNIVERSE}{choice}": alternative for choice, alternative in universe.picks}
+        rows, missing = [], 0
+        for name in multiverse.experiments:
+            series = kept_series(multiverse.experiment_configs[universe.name, name])
+            found, absent = stored_rows(multiverse.runs[universe.name, name], Store(store_root, name), series)
+            rows, missing = rows + [{**picks, **r} for r in found], missing + absent
+        if missing:
+            print(f"skipped: {multiverse.name}, universe {universe.name}: {missing} runs not in the store",
+                  file=sys.stderr)
+        else:
+            write_table(runs_table(rows), path)
+    for stray in set(path.parent.glob("*.parquet")) - kept:  # a universe no longer in the design
+        stray.unlink()
+    written = sorted(p for p in kept if p.exists())
+    if not written:
+        raise ConfigError(f"{multiverse.name}: no universe has all its paper-scale runs in the store; run them first: "
+                          f"pf-replicate experiment={multiverse.name} scale=paper")
+    return Entry.of(written, record, [r for p in written for r in read_rows(p)])
+
+
+def _at_paper_scale(cfg: DictConfig) -> DictConfig:
+    if cfg.scale != SCALE:
+        raise ConfigError(f"the record holds the paper scale; got scale={cfg.scale}")
+    return cfg
+
+
+def _complete(name: str, missing: int, total: int) -> None:
+    if missing:
+        raise ConfigError(f"{name}: {missing} of {total} paper-scale runs are not in the store; run them first: "
+                          f"pf-replicate experiment={name} scale=paper")
+
+
+def write_curves(experiment: dict, records: pd.DataFrame, folder: Path) -> list[Path]:
+    """The table of each of the experiment's curve figures (:mod:`replication.evidence.curves`), from the
+    runs' per-frame series, as ``<folder>/<figure>.parquet`` (floats in single precision: drawn, not
+    tested); the files written (those of figures no longer configured are removed)."""
+    shutil.rmtree(folder, ignore_errors=True)
+    written = []
+    for spec in experiment.get("report", {}).get("figures", []):
+        if spec["kind"] not in CURVES or records.empty:
+            continue
+        table = curve_table(records, spec, experiment)
+        if len(table):
+            table = table.astype({c: "float32" for c in table if table[c].dtype == "float64"})
+            written.append(folder / f"{spec['name']}.parquet")
+            write_table(pa.Table.from_pandas(table, preserve_index=False), written[-1])
+    return written
+
+
+def write(cfgs: list[DictConfig], store_root: Path, record: Path, skip_incomplete: bool = False) -> Manifest:
+    """Write each experiment or multiverse of ``cfgs`` and the manifest; the manifest.  With
+    ``skip_incomplete`` one whose runs the store does not all hold is left as it is, with one line."""
+    manifest = Manifest.read(record)
+    for cfg in cfgs:
+        writer = write_multiverse if "multiverse" in cfg.experiment else write_experiment
+        try:
+            entry = writer(cfg, store_root, record)
+        except ConfigError as error:
+            if not skip_incomplete:
+                raise
+            print(f"skipped: {error}", file=sys.stderr)
+            continue
+        manifest = manifest.with_entry(cfg.experiment.name, entry)
+        manifest.write(record)  # after each: an experiment written is in the manifest, whatever comes next
+        print(f"{cfg.experiment.name}: {entry.runs} runs ({entry.failed} failed), {entry.bytes / 1e6:.2f} MB",
+              flush=True)
+    return manifest

@@ -1,0 +1,78 @@
+"""``pf-replicate diff A B``: every claim and published cell whose verdict or estimate differs between two
+sets of results, before and after.
+
+A and B are each a record folder (``record/``: its pages are drawn first, as ``report source=record``
+draws them), a drawn report folder (one holding ``claims.csv`` and ``summary.csv``: ``reports``,
+``reports/record``), or ``store``: the runs in the store at the paper scale.  One line per changed claim
+(verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict), then
+the totals.
+"""
+
+import sys
+import tempfile
+from contextlib import ExitStack
+from pathlib import Path
+
+import pandas as pd
+
+from replication.errors import fail
+from replication.record.manifest import MANIFEST, PAGES
+
+CLAIM = ("claim_id",)
+CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost")
+CELL = ("paper", "table", "experiment", "method", "metric", "condition")
+CELL_FIELDS = ("ours", "runs", "verdict", "reason")
+
+
+def drawn(source: str, scratch: Path) -> Path:
+    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it first if need be."""
+    from replication.report.__main__ import main as report
+
+    path = Path(source)
+    if (path / "claims.csv").exists() and (path / "summary.csv").exists():
+        return path
+    if (path / MANIFEST).exists():
+        report(["source=record", f"record={path.resolve()}", f"reports={scratch}", "pdf=false"])
+        return scratch / PAGES
+    if source == "store":
+        report(["scale=paper", f"reports={scratch}", "pdf=false"])
+        return scratch
+    fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no claims.csv and summary.csv) nor 'store'")
+
+
+def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...], fields: tuple[str, ...]) -> list[str]:
+    """One line per row (by ``key``) whose ``fields`` differ, or that only one side has."""
+    joined = before.merge(after, on=list(key), how="outer", suffixes=("_a", "_b"), indicator=True)
+    lines = []
+    for row in joined.fillna("").astype(str).to_dict("records"):
+        name = " ".join(row[k] for k in key if row[k])
+        if row["_merge"] != "both":
+            lines.append(f"{name}: only in {'A' if row['_merge'] == 'left_only' else 'B'}")
+            continue
+        moved = [f"{f} {row[f + '_a'] or '-'!r} -> {row[f + '_b'] or '-'!r}" for f in fields
+                 if f + "_a" in row and row[f + "_a"] != row[f + "_b"]]
+        if moved:
+            lines.append(f"{name}: " + "; ".join(moved))
+    return lines
+
+
+def main(argv: list[str]) -> None:
+    if {"--help", "-h"} & set(argv) or len(argv) != 2:
+        print(__doc__.strip())
+        if len(argv) != 2 and not {"--help", "-h"} & set(argv):
+            sys.exit(2)
+        return
+    with ExitStack() as stack:
+        folders = [drawn(source, Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="diff-"))))
+                   for source in argv]
+        claims = [pd.read_csv(folder / "claims.csv", dtype=str) for folder in folders]
+        cells = [pd.read_csv(folder / "summary.csv", dtype=str) for folder in folders]
+    claim_lines = changes(*claims, CLAIM, CLAIM_FIELDS)
+    cell_lines = changes(*cells, CELL, CELL_FIELDS)
+    print(f"A: {argv[0]}\nB: {argv[1]}")
+    for title, lines in (("claims", claim_lines), ("published cells", cell_lines)):
+        print(f"\n{title}: {len(lines)} changed")
+        print(*lines, sep="\n", end="\n" if lines else "")
+    verdicts = sum("verdict " in line for line in claim_lines)
+    print(f"\n{len(claims[1])} claims: {verdicts} changed verdict, {len(claim_lines)} changed at all; "
+          f"{len(cells[1])} cells: {len(cell_lines)} changed")

@@ -1,0 +1,66 @@
+"""The paper-scale record on the report's index: where its runs came from, whether this code made them,
+whether this machine computed any of them again, and its verdicts beside this machine's.
+
+``python -m replication.report source=record`` draws the record's pages into ``<reports>/record/`` and
+writes :data:`STATUS` there (:func:`write_status`); ``pf-replicate verify against=store`` writes
+:data:`~replication.record.manifest.RECOMPUTED` beside it.  :func:`recorded` reads both for the index.
+"""
+
+import datetime
+import json
+from pathlib import Path
+
+from replication.evidence.claims import Paper
+from replication.evidence.scorecard import ClaimRow, claim_rows
+from replication.evidence.summary import load_summaries
+from replication.record.manifest import PAGES, RECOMPUTED, Manifest
+
+STATUS = "status.json"
+
+
+def write_status(out: Path, manifest: Manifest, stale: dict[str, int]) -> Path:
+    """``<out>/status.json``: the manifest's account of the runs drawn, and per experiment how many of its
+    recorded runs other code or settings than this checkout's made (``stale``)."""
+    entries = {name: manifest.experiments[name] for name in stale}
+    status = {
+        "runs": sum(e.runs for e in entries.values()),
+        "failed": sum(e.failed for e in entries.values()),
+        "cpu_hours": round(sum(e.wall_s for e in entries.values()) / 3600, 1),
+        "commits": sorted({c[:7] for e in entries.values() for c in e.commits}),
+        "first": min((e.first_computed for e in entries.values() if e.first_computed), default=None),
+        "last": max((e.last_computed for e in entries.values() if e.last_computed), default=None),
+        "experiments": {name: {"runs": entries[name].runs, "stale": n, "minutes": _minutes(entries[name]),
+                               "cpu_minutes": round(entries[name].wall_s / 60, 1)} for name, n in stale.items()},
+    }
+    path = out / STATUS
+    path.write_text(json.dumps(status, indent=1) + "\n")
+    return path
+
+
+def _minutes(entry) -> float | None:
+    """Minutes between the completion of the experiment's first and last recorded runs: its wall time on the
+    machine that made it, less its first run (runs in parallel; None without times)."""
+    if entry.first_computed is None:
+        return None
+    first, last = (datetime.datetime.fromisoformat(t) for t in (entry.first_computed, entry.last_computed))
+    return round((last - first).total_seconds() / 60, 1)
+
+
+def recorded(reports: Path, papers: tuple[Paper, ...]) -> dict | None:
+    """What the index shows of the record drawn under ``reports`` (None where none was drawn): its status,
+    the experiments other code made, this machine's recomputation, and each claim's recorded row by id."""
+    folder = Path(reports) / PAGES
+    if not (folder / STATUS).exists():
+        return None
+    status = json.loads((folder / STATUS).read_text())
+    again = json.loads((folder / RECOMPUTED).read_text()) if (folder / RECOMPUTED).exists() else None
+    rows: dict[str, ClaimRow] = {row.claim.id: row for paper_rows in
+                                 claim_rows(list(papers), load_summaries(folder)).values() for row in paper_rows}
+    return {
+        **status,
+        "stale": {name: e for name, e in status["experiments"].items() if e["stale"]},
+        "recomputed": None if again is None else {
+            "runs": sum(e["compared"] for e in again.values()),
+            "differ": [line for e in again.values() for line in e["differ"]]},
+        "claims": rows,
+    }

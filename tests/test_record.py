@@ -1,0 +1,299 @@
+"""The paper-scale record (issue 35): runs as typed tidy tables that read back as the store's records, a
+manifest that names a damaged file, verification that re-computes runs and names what differs, and the
+report drawn from the record."""
+
+import dataclasses
+import hashlib
+import json
+import subprocess
+import sys
+from collections import Counter
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+from conftest import PROJECT_ROOT
+
+from replication.errors import ConfigError
+from replication.evidence.curves import CURVES, curve_table
+from replication.evidence.published import load_published
+from replication.evidence.tables import TableKind
+from replication.record.manifest import Manifest
+from replication.record.runs import RUNS_FILE, Record, read_rows
+from replication.record.verify import compare, recomputed, same_value, sample, verify
+from replication.record.write import kept_series, write, write_experiment
+from replication.report.figures import draw
+from replication.report.figures.style import NothingToDraw
+from replication.runner.config import expand, experiment_at_scale
+from replication.runner.execute import execute
+from replication.runner.store import Store
+
+UNGM = ("scale=paper", "experiment.runs.paper=2", "experiment.model.steps=10")
+# bis_pf's 3123 test at its full length, one run per method: the runs whose strip the modes table reads
+BALLS = ("scale=paper", "experiment.runs.paper=1", "experiment.model.sweep.scene=[exp1_3123]")
+
+
+def stored(make_cfg, tmp_path, experiment, overrides):
+    cfg = make_cfg(experiment, *overrides)
+    runs = expand(cfg)
+    store = Store(tmp_path / "experiments", experiment)
+    execute(runs, store, n_jobs=1, progress=False)
+    return cfg, runs, store
+
+
+def same_records(a, b) -> bool:
+    """Two record tables hold the same runs with the same values (NaN equal to NaN), in any column order."""
+    def plain(value):
+        return None if isinstance(value, float) and value != value else value
+    return (len(a) == len(b) and set(a.columns) == set(b.columns)
+            and all(same_value(plain(x), plain(y)) or (plain(x) is None and plain(y) is None)
+                    for column in a.columns for x, y in zip(a[column], b[column])))
+
+
+def test_a_record_reads_back_as_the_store_it_was_written_from(make_cfg, tmp_path):
+    cfg, runs, store = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    entry = write_experiment(cfg, tmp_path / "experiments", tmp_path / "record")
+    assert (entry.runs, entry.failed, list(entry.files)) == (len(runs), 0, [f"gps_qmcpf/{RUNS_FILE}"])
+    assert same_records(Record(tmp_path / "record").load(runs), store.load(runs))
+    schema = pq.read_schema(tmp_path / "record" / list(entry.files)[0])
+    assert schema.field("method.n_particles").type == pa.int64()  # a swept parameter, as a number
+    assert schema.field("condition.N").type == pa.int64() and schema.field("rmse").type == pa.float64()
+    assert not {"condition", "data_condition", "run_id"} & set(schema.names)  # no packed labels
+
+
+def test_the_manifest_names_a_damaged_file_and_keeps_an_unchanged_entry(make_cfg, tmp_path):
+    cfg, _, _ = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    record = tmp_path / "record"
+    manifest = write([cfg], tmp_path / "experiments", record)
+    assert manifest.damaged(record) == [] and Manifest.read(record) == manifest
+    older = dataclasses.replace(manifest.experiments["gps_qmcpf"], written="2020-01-01")
+    assert Manifest({"gps_qmcpf": older}).with_entry("gps_qmcpf", manifest.experiments["gps_qmcpf"]).experiments[
+        "gps_qmcpf"].written == "2020-01-01"  # the same bytes again: the entry and its date stay
+    path = record / "gps_qmcpf" / RUNS_FILE
+    path.write_bytes(path.read_bytes()[:-1] + b"x")
+    assert manifest.damaged(record) == ["gps_qmcpf/runs.parquet"]
+
+
+def test_failed_runs_are_recorded_with_their_reason_and_a_missing_run_stops_the_writer(make_cfg, tmp_path):
+    cfg = make_cfg("gps_qmcpf", *UNGM)
+    runs = expand(cfg)
+    store = Store(tmp_path / "experiments", "gps_qmcpf")
+    execute(runs[1:], store, n_jobs=1, progress=False)
+    with pytest.raises(ConfigError, match=f"gps_qmcpf: 1 of {len(runs)} paper-scale runs are not in the store"):
+        write_experiment(cfg, tmp_path / "experiments", tmp_path / "record")
+    store.write_failure(runs[0], "rmse is not finite")
+    entry = write_experiment(cfg, tmp_path / "experiments", tmp_path / "record")
+    record = Record(tmp_path / "record")
+    assert entry.failed == 1 and record.failures(runs) == Counter({"rmse is not finite": 1})
+    assert len(record.load(runs)) == len(runs) - 1
+
+
+def test_only_the_series_a_table_reads_are_kept_and_its_table_is_the_stores(make_cfg, tmp_path):
+    cfg, runs, store = stored(make_cfg, tmp_path, "bis_pf", BALLS)
+    experiment = experiment_at_scale(cfg)
+    assert kept_series(experiment) == ("strip",)  # the modes table's; per_frame only feeds figures
+    write_experiment(cfg, tmp_path / "experiments", tmp_path / "record")
+    rows = read_rows(tmp_path / "record" / "bis_pf" / RUNS_FILE)
+    assert all("per_frame" not in r for r in rows) and all("strip" in r for r in rows)
+    from_record, from_store = Record(tmp_path / "record").load(runs), store.load(runs)
+    spec = next(t for t in experiment["report"]["tables"] if t.get("kind") == "modes")
+    published = load_published(str(PROJECT_ROOT.parent / "shared" / "reference" / "published_values.csv"))
+    built = [TableKind.of(spec, experiment, published).build(r).written() for r in (from_record, from_store)]
+    assert built[0].equals(built[1]) and len(built[0])
+    curve = next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve")
+    with pytest.raises(NothingToDraw, match="drawn from each run's per_frame, which these records do not hold"):
+        draw(from_record, curve, experiment, tmp_path / "curve.png")
+    kept = Record(tmp_path / "record").curves("bis_pf")  # instead, the curve the figure draws
+    curves = {f["name"] for f in experiment["report"]["figures"] if f["kind"] in CURVES}
+    assert curve["name"] in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
+    table = curve_table(from_store, curve, experiment)
+    assert list(kept[curve["name"]].columns) == list(table.columns) and len(table) > 100
+    assert np.allclose(kept[curve["name"]]["mean"], table["mean"], rtol=1e-6)  # single precision
+    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]]).exists()
+
+
+def test_verify_finds_every_run_identical_then_names_a_changed_number(make_cfg, tmp_path):
+    cfg, runs, store = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    record = tmp_path / "record"
+    write([cfg], tmp_path / "experiments", record)
+    assert verify([cfg], Record(record), 6, cheapest=False, rtol=0.0, n_jobs=1, progress=False) == []
+    path = record / "gps_qmcpf" / RUNS_FILE
+    table = pq.read_table(path)
+    rmse = table.column("rmse").to_pylist()
+    rmse[0] *= 1 + 1e-15  # one ulp or so: exact means exact
+    pq.write_table(table.set_column(table.schema.get_field_index("rmse"), "rmse", pa.array(rmse)), path)
+    found = verify([cfg], Record(record), None, cheapest=False, rtol=0.0, n_jobs=1, progress=False)
+    assert [d.columns[0][0] for d in found] == ["rmse"] and found[0].run.run_id == runs[0].run_id
+    assert verify([cfg], Record(record), None, cheapest=False, rtol=1e-12, n_jobs=1, progress=False) == []
+
+
+def test_verify_on_the_command_line_prints_the_difference_and_fails(make_cfg, tmp_path):
+    settings = ("experiment.runs.paper=1", "experiment.model.steps=5")
+    cfg, runs, _ = stored(make_cfg, tmp_path, "gps_qmcpf", ("scale=paper", *settings))
+    record = tmp_path / "record"
+    write([cfg], tmp_path / "experiments", record)
+    path = record / "gps_qmcpf" / RUNS_FILE
+    table = pq.read_table(path)
+    rmse = [v + 1.0 for v in table.column("rmse").to_pylist()[:1]] + table.column("rmse").to_pylist()[1:]
+    pq.write_table(table.set_column(table.schema.get_field_index("rmse"), "rmse", pa.array(rmse)), path)
+    command = [sys.executable, "-m", "replication", "verify", f"record={record}", "N=all", "n_jobs=1",
+               "experiment=gps_qmcpf", "progress=false", *settings]
+    done = subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2 and "no longer match the manifest's SHA-256" in done.stderr  # an edited file
+    manifest = Manifest.read(record)
+    entry = dataclasses.replace(manifest.experiments["gps_qmcpf"],
+                                files={"gps_qmcpf/runs.parquet": hashlib.sha256(path.read_bytes()).hexdigest()})
+    manifest.with_entry("gps_qmcpf", entry).write(record)
+    done = subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1, done.stderr
+    assert f"gps_qmcpf {runs[0].run_id}: rmse recorded" in done.stdout
+    assert f"verified {len(runs)} recorded runs of 1 experiments and universes: 1 differ" in done.stdout
+
+
+def test_comparing_records_by_hand():
+    assert compare({"rmse": float("nan"), "n": 3, "xs": [1.0, 2.0]}, {"rmse": float("nan"), "n": 3, "xs": [1.0, 2.0],
+                                                                     "wall_s": 9.0, "run_id": "x"}) == ()
+    assert compare({"rmse": 1.0}, {"rmse": 1.0 + 1e-13}) == (("rmse", 1.0, 1.0 + 1e-13),)
+    assert compare({"rmse": 1.0}, {"rmse": 1.0 + 1e-13}, rtol=1e-12) == ()
+    assert compare({"rmse": 1.0}, {"rmse": 1.0, "ess": 4.0}) == (("ess", None, 4.0),)  # a new metric
+    assert compare({"rmse": 1.0, "ess": None}, {"rmse": 1.0}) == ()  # a value neither has
+    assert compare({"strip": {"density": [[0.5, 0.5]]}}, {"strip": {"density": [[0.5, 0.25]]}})[0][0] == "strip"
+    assert compare({"failure": "rmse is not finite"}, {"failure": "rmse is not finite"}) == ()
+    assert compare({"failure": "rmse is not finite"}, {"rmse": 2.0})[0] == ("failure", "rmse is not finite", None)
+    assert compare({"rmse": 1.0}, {"rmse": 1.0, "per_frame": {"cle": [1.0]}}) == ()  # a series not kept
+
+
+def test_the_sample_takes_every_experiment_and_the_rest_in_proportion():
+    pairs = {"a": [(i, {"wall_s": float(10 - i)}) for i in range(10)], "b": [(i, {"wall_s": 1.0}) for i in range(90)]}
+    chosen = sample(pairs, 20, cheapest=False)
+    assert Counter(id(p) in {id(q) for q in pairs["a"]} for p in chosen) == {True: 2, False: 18}
+    assert sample(pairs, 20, cheapest=False) == chosen  # its own seed: the same N, the same runs
+    assert [run for run, _ in sample(pairs, 1, cheapest=True)[:1]] == [9]  # a's quickest
+    assert len(sample(pairs, None, cheapest=False)) == 100
+
+
+def test_runs_made_by_other_code_are_named_and_recomputed_runs_compared(make_cfg, tmp_path):
+    cfg, runs, store = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    write([cfg], tmp_path / "experiments", tmp_path / "record")
+    record = Record(tmp_path / "record")
+    assert record.stale(runs) == []
+    changed = [dataclasses.replace(run, key="0" * 10) for run in runs[:3]]
+    assert record.stale(changed) == changed and len(record.load(changed)) == 3  # still read: the same identity
+    quick = make_cfg("gps_qmcpf", "scale=quick", "experiment.runs.quick=1", "experiment.model.steps=10")
+    found = recomputed([quick], tmp_path / "experiments", record)["gps_qmcpf"]
+    first = [run for run in runs if run.repetition == 0]
+    assert found == {"compared": len(first), "differ": []}  # a quick run with a recorded run's key: the same
+
+
+def test_the_report_drawn_from_a_record_shows_its_verdicts_beside_this_machines(make_cfg, tmp_path):
+    cfg = make_cfg("hspf_ungm", "scale=paper")  # the shipped experiment as it is (300 runs of 100 steps)
+    runs = expand(cfg)
+    execute(runs, Store(tmp_path / "experiments", "hspf_ungm"), n_jobs=2, progress=False)
+    write([cfg], tmp_path / "experiments", tmp_path / "record")
+    reports = tmp_path / "reports"
+    command = [sys.executable, "-m", "replication", "report", "source=record", f"record={tmp_path / 'record'}",
+               f"reports={reports}", "pdf=false"]
+    done = subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    status = json.loads((reports / "record" / "status.json").read_text())
+    assert status["runs"] == len(runs) and status["experiments"]["hspf_ungm"]["runs"] == len(runs)
+    assert status["experiments"]["hspf_ungm"]["stale"] == 0 and status["experiments"]["hspf_ungm"]["cpu_minutes"] > 0
+    from replication.evidence.claims import load_papers
+    from replication.report.pages.index import write_index
+    from replication.report.pages.recorded import recorded
+
+    shown = recorded(reports, load_papers())
+    assert shown["runs"] == len(runs) and shown["stale"] == {} and shown["recomputed"] is None
+    judged = {claim for claim, row in shown["claims"].items() if row.primary.scale == "paper"}
+    assert judged and all(claim.startswith("hspf.") for claim in judged)  # the recorded experiment's claims
+    page = write_index(reports).read_text()
+    assert "paper scale (recorded at " in page and f"{len(runs)} runs of 1 experiments" in page
+    assert 'href="record/hspf_ungm/index.html#claims"' in page
+
+
+def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically():
+    """The record in the repository: every file has its manifest's SHA-256 and holds its runs, and the
+    quickest recorded run of each experiment is computed again here, to the same numbers."""
+    from hydra import compose, initialize_config_dir
+
+    from replication.paths import CONF_DIR
+
+    folder = PROJECT_ROOT / "record"
+    manifest = Manifest.read(folder)
+    if not manifest.experiments:
+        pytest.skip("no record shipped in this checkout")
+    assert manifest.damaged(folder) == []
+    for name, entry in manifest.experiments.items():
+        assert sum(len(read_rows(folder / file)) for file in entry.files if "/curves/" not in file) == entry.runs, name
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfgs = [compose("config", overrides=[f"experiment={name}", "scale=paper"]) for name in manifest.experiments]
+    assert verify(cfgs, Record(folder), len(cfgs), cheapest=True, rtol=0.0, n_jobs=2, progress=False) == []
+
+
+def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):
+    from replication.report.diff import main as diff
+
+    claims = pd.DataFrame({"claim_id": ["p.a", "p.b"], "verdict": ["holds", "inconclusive"],
+                           "number": ["1.2 [0.5, 1.9]", "0.1 [-0.3, 0.5]"], "runs": ["10", "10"]})
+    cells = pd.DataFrame({"paper": ["p"], "table": ["1"], "experiment": ["e"], "method": ["PF"], "metric": ["rmse"],
+                          "condition": ["N=100"], "ours": ["4.1 [3.9, 4.3]"], "verdict": ["reproduced"]})
+    for name, (c, s) in {"a": (claims, cells),
+                         "b": (claims.assign(verdict=["holds", "does not hold"]), cells.assign(ours="4.2 [4.0, 4.4]"))
+                         }.items():
+        (tmp_path / name).mkdir()
+        c.to_csv(tmp_path / name / "claims.csv", index=False)
+        s.to_csv(tmp_path / name / "summary.csv", index=False)
+    diff([str(tmp_path / "a"), str(tmp_path / "b")])
+    out = capsys.readouterr().out
+    assert "p.b: verdict 'inconclusive' -> 'does not hold'" in out and "p.a:" not in out
+    assert "p 1 e PF rmse N=100: ours '4.1 [3.9, 4.3]' -> '4.2 [4.0, 4.4]'" in out
+    assert "2 claims: 1 changed verdict, 1 changed at all; 1 cells: 1 changed" in out
+    with pytest.raises(SystemExit):
+        diff([str(tmp_path / "a"), str(tmp_path / "nothing")])
+
+
+def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_record_as_from_the_store(tmp_path):
+    from hydra import compose, initialize_config_dir
+    from omegaconf import OmegaConf
+
+    from replication.paths import CONF_DIR
+    from replication.report.pages.multiverse import write_multiverse_report
+    from replication.runner.multiverse import load
+
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        top = OmegaConf.to_container(compose("config", overrides=[
+            "experiment=hspf_ungm", "scale=paper", f"store={tmp_path}/store", "progress=false"]), resolve=True)
+    hms = {"hms": {"label": "harmony memory size", "alternatives": {
+        "paper": {"why": "HMS = 2, section 4.1", "set": {"methods.HSPF.hms": 2}},
+        "larger": {"why": "a larger memory", "set": {"methods.HSPF.hms": 4}}}}}
+    top["experiment"] = {"name": "hspf_test_readings", "paper": "hspf", "title": "test", "choices": hms,
+                         "multiverse": {"experiments": ["hspf_ungm"], "runs": {"paper": 5, "quick": 5},
+                                        "design": "full"}}
+    cfg = OmegaConf.create(top)
+    multiverse = load(cfg)
+    execute(multiverse.runs_of("hspf_ungm"), Store(tmp_path / "store", "hspf_ungm"), n_jobs=2, progress=False)
+    entry = write([cfg], tmp_path / "store", tmp_path / "record").experiments["hspf_test_readings"]
+    assert entry.runs == sum(len(runs) for runs in multiverse.runs.values())  # a shared run in each universe
+    assert sorted(entry.files) == ["hspf_test_readings/universes/default.parquet",
+                                   "hspf_test_readings/universes/hms=larger.parquet"]
+    record = Record(tmp_path / "record")
+    for universe in multiverse.universes:
+        runs = multiverse.runs[universe.name, "hspf_ungm"]
+        assert same_records(record.universe(multiverse.name, universe.name).load(runs),
+                            Store(tmp_path / "store", "hspf_ungm").load(runs))
+    larger = next(u for u in multiverse.universes if not u.is_default)
+    stale = record.universe(multiverse.name, larger.name).stale(multiverse.runs["default", "hspf_ungm"])
+    assert {run.method for run in stale} == {"HSPF"}  # its HSPF runs are not the default universe's
+    pages = []
+    for where, store_of in (("store", None),
+                            ("record", lambda name, u: record.universe(multiverse.name, u.name))):
+        cfg.reports = str(tmp_path / where)
+        pages.append(write_multiverse_report(cfg, multiverse, (), store_of).parent)
+    assert (pages[0] / "cases.csv").read_text() == (pages[1] / "cases.csv").read_text()
+    assert verify([cfg], record, 4, cheapest=False, rtol=0.0, n_jobs=2, progress=False) == []
+    larger_runs = multiverse.runs[larger.name, "hspf_ungm"]  # a universe not all run: left out, the other kept
+    Store(tmp_path / "store", "hspf_ungm").path(next(r for r in larger_runs if r.method == "HSPF")).unlink()
+    partial = write([cfg], tmp_path / "store", tmp_path / "partial").experiments["hspf_test_readings"]
+    assert list(partial.files) == ["hspf_test_readings/universes/default.parquet"]
