@@ -55,8 +55,9 @@ class Difference:
 
 
 def sample(recorded: dict[str, list[tuple[Run, dict]]], n: int | None, cheapest: bool) -> list[tuple[Run, dict]]:
-    """``n`` of the recorded (run, row) pairs (all for None), each experiment at least one and the rest in
-    proportion to its runs: drawn at random with :data:`SAMPLE_SEED`, or its quickest with ``cheapest``."""
+    """About ``n`` of the recorded (run, row) pairs (all for None), each stratum (an experiment, a universe)
+    at least one and the rest in proportion to its runs: drawn at random with :data:`SAMPLE_SEED`, or its
+    quickest with ``cheapest``."""
     total = sum(len(pairs) for pairs in recorded.values())
     rng = np.random.default_rng(SAMPLE_SEED)
     chosen = []
