@@ -33,21 +33,24 @@ class Entry:
     libraries: tuple[str, ...]  # "python 3.11.2, numpy 2.1.3, ..." per distinct set
     machines: tuple[str, ...]
     written: str  # the date the file was written
+    universes: int = 0  # a multiverse's universes recorded (0: an experiment)
 
     @classmethod
-    def of(cls, paths: list[Path], record: Path, rows: list[dict]) -> "Entry":
+    def of(cls, paths: list[Path], record: Path, rows: list[dict], universes: int = 0) -> "Entry":
+        """The entry of ``paths`` holding ``rows`` (a run several universes share counts once in ``wall_s``)."""
         computed = sorted(r["computed_at"] for r in rows if r.get("computed_at"))
+        distinct = {(r["experiment"], r["method"], r["run_key"], r["repetition"]): r for r in rows}.values()
         return cls(
             files={path.relative_to(record).as_posix(): sha256(path) for path in paths},
             bytes=sum(path.stat().st_size for path in paths),
             runs=len(rows), failed=sum(1 for r in rows if r.get("failure")),
-            wall_s=round(sum(r.get("wall_s") or 0.0 for r in rows), 1),
+            wall_s=round(sum(r.get("wall_s") or 0.0 for r in distinct), 1),
             first_computed=computed[0] if computed else None, last_computed=computed[-1] if computed else None,
             commits=_distinct(rows, "git_commit"), dirty=any(bool(r.get("git_dirty")) for r in rows),
             code_digests=_distinct(rows, "code_digest"),
             libraries=tuple(sorted({", ".join(f"{k.removesuffix('_version')} {r.get(k)}" for k in LIBRARIES)
                                     for r in rows if not r.get("failure")})),
-            machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat())
+            machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat(), universes=universes)
 
 
 @dataclass(frozen=True)

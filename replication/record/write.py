@@ -98,7 +98,7 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
     if not written:
         raise ConfigError(f"{multiverse.name}: no universe has all its paper-scale runs in the store; run them first: "
                           f"pf-replicate experiment={multiverse.name} scale=paper")
-    return Entry.of(written, record, [r for p in written for r in read_rows(p)])
+    return Entry.of(written, record, [r for p in written for r in read_rows(p)], universes=len(written))
 
 
 def _at_paper_scale(cfg: DictConfig) -> DictConfig:

@@ -29,7 +29,8 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int]) -> Path:
         "commits": sorted({c[:7] for e in entries.values() for c in e.commits}),
         "first": min((e.first_computed for e in entries.values() if e.first_computed), default=None),
         "last": max((e.last_computed for e in entries.values() if e.last_computed), default=None),
-        "experiments": {name: {"runs": entries[name].runs, "stale": n, "minutes": _minutes(entries[name]),
+        "experiments": {name: {"runs": entries[name].runs, "stale": n, "universes": entries[name].universes,
+                               "minutes": None if entries[name].universes else _minutes(entries[name]),
                                "cpu_minutes": round(entries[name].wall_s / 60, 1)} for name, n in stale.items()},
     }
     path = out / STATUS
@@ -39,7 +40,8 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int]) -> Path:
 
 def _minutes(entry) -> float | None:
     """Minutes between the completion of the experiment's first and last recorded runs: its wall time on the
-    machine that made it, less its first run (runs in parallel; None without times)."""
+    machine that made it, less its first run (runs in parallel; None without times).  Not for a multiverse,
+    whose universes reuse runs its experiments made at other times."""
     if entry.first_computed is None:
         return None
     first, last = (datetime.datetime.fromisoformat(t) for t in (entry.first_computed, entry.last_computed))
