@@ -68,7 +68,7 @@ def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
     _complete(name, missing, len(runs))
     path = record / name / RUNS_FILE
     write_table(runs_table(rows), path)
-    return Entry.of([path, *write_curves(experiment, store.load(runs), record / name / CURVES_DIR)], record, rows)
+    return Entry.of([path, *write_curves(experiment, store, runs, record / name / CURVES_DIR)], record, rows)
 
 
 def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
@@ -113,15 +113,16 @@ def _complete(name: str, missing: int, total: int) -> None:
                           f"pf-replicate experiment={name} scale=paper")
 
 
-def write_curves(experiment: dict, records: pd.DataFrame, folder: Path) -> list[Path]:
+def write_curves(experiment: dict, store: Store, runs: list[Run], folder: Path) -> list[Path]:
     """The table of each of the experiment's curve figures (:mod:`replication.evidence.curves`), from the
-    runs' per-frame series, as ``<folder>/<figure>.parquet`` (floats in single precision: drawn, not
-    tested); the files written (those of figures no longer configured are removed)."""
+    runs' per-frame series in ``store`` (read only for an experiment with such a figure), as
+    ``<folder>/<figure>.parquet`` (floats in single precision: drawn, not tested); the files written
+    (those of figures no longer configured are removed)."""
     shutil.rmtree(folder, ignore_errors=True)
+    specs = [spec for spec in experiment.get("report", {}).get("figures", []) if spec["kind"] in CURVES]
+    records = store.load(runs) if specs else pd.DataFrame()
     written = []
-    for spec in experiment.get("report", {}).get("figures", []):
-        if spec["kind"] not in CURVES or records.empty:
-            continue
+    for spec in specs if len(records) else []:
         table = curve_table(records, spec, experiment)
         if len(table):
             table = table.astype({c: "float32" for c in table if table[c].dtype == "float64"})
