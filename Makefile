@@ -1,5 +1,5 @@
 # make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html and reports/replication.pdf
-# make test        set up and run the test suite (the long paper-scale runs are marked slow and skipped)
+# make test        set up and run the test suite on JOBS (2) workers (the long paper-scale runs are marked slow and skipped)
 # make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
@@ -8,6 +8,8 @@
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
 # make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does)
+#                  and render each paper's findings from it (docs/findings/, from docs/findings/templates/)
+# make findings    render each paper's findings from the record into docs/findings/ (after editing a template)
 # make verify      re-compute N (200) recorded runs here and compare them with the record; N=all for every one
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
@@ -26,7 +28,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate record verify
+.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate record verify findings
 
 setup: $(VENV)/.installed
 
@@ -48,13 +50,13 @@ browser:
 		|| echo "chromium not installed: the headless-browser report test will be skipped"
 
 test: setup browser
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadgroup
 
 test-fast: setup
-	$(BIN)/python -m pytest -m "not slow and not e2e"
+	$(BIN)/python -m pytest -m "not slow and not e2e" -n $(JOBS) --dist loadgroup
 
 test-all: setup browser
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(JOBS) --dist loadgroup
 
 # One Hydra multirun over every experiment: one process and one pool of workers for all of them,
 # instead of starting Python, numba and the workers again per experiment (about two minutes at quick scale).
@@ -64,7 +66,7 @@ test-all: setup browser
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
-	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python -m replication report source=record pdf=false)
+	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python -m replication findings)
 	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
 	$(BIN)/python -m replication.report.pages.calibration
@@ -76,7 +78,10 @@ readings: setup
 
 record: setup
 	$(BIN)/python -m replication record
-	$(BIN)/python -m replication report source=record pdf=false
+	$(BIN)/python -m replication findings
+
+findings: setup
+	$(BIN)/python -m replication findings
 
 verify: setup
 	$(BIN)/python -m replication verify N=$(N) n_jobs=$(JOBS)

@@ -1,4 +1,4 @@
-"""``pf-replicate [run|report|scenes|export|record|verify|diff] key=value ...`` (or ``python -m replication``): the one
+"""``pf-replicate [run|report|scenes|export|record|verify|diff|findings] key=value ...`` (or ``python -m replication``): the one
 entry point.
 
 ``run`` (the default) checks the request, runs what is missing and writes the experiment's report;
@@ -7,7 +7,8 @@ an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`); 
 tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod:`replication.export`);
 ``record`` writes the paper-scale record from the store and ``verify`` re-computes a sample of it
 (:mod:`replication.record`); ``diff A B`` lists the claims and cells whose verdict or estimate differ
-between two records or reports (:mod:`replication.report.diff`).
+between two records or reports (:mod:`replication.report.diff`); ``findings`` renders each paper's findings
+from the record into ``docs/findings/`` (:mod:`replication.report.findings`).
 
 Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
@@ -50,6 +51,7 @@ SUBCOMMANDS = {
     "record": "replication.record.__main__:main",
     "verify": "replication.record.verify:main",
     "diff": "replication.report.diff:main",
+    "findings": "replication.report.__main__:findings",
 }
 
 

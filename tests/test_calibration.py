@@ -14,6 +14,8 @@ from replication.evidence.claims import load_papers
 SHIPPED = PACKAGE_DIR.parent / "reports" / CSV
 
 
+pytestmark = pytest.mark.xdist_group("calibration")  # make test -n 2: one worker builds the fixture
+
 @pytest.fixture(scope="module")
 def quick():
     return calibration.calibrate(calibration.QUICK_REPLICATIONS, runs=(5, 20))

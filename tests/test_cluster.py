@@ -25,7 +25,9 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
     return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
 
 
-pytestmark = pytest.mark.e2e  # clusters and subprocesses: make test-fast leaves them out
+# clusters and subprocesses: make test-fast leaves them out; one xdist worker runs them all (make test's
+# --dist loadgroup), so two ray heads or dask clusters never start at once
+pytestmark = [pytest.mark.e2e, pytest.mark.xdist_group("clusters")]
 
 
 @pytest.fixture(scope="module")

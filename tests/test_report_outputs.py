@@ -165,6 +165,8 @@ def test_matched_cells_name_every_published_cell_a_table_matched(name):
 # -- a real (small) report: HTML pages, PDF, a browser's view -------------------------------------------
 
 
+pytestmark = pytest.mark.xdist_group("report_outputs")  # make test -n 2: one worker builds the fixture
+
 @pytest.fixture(scope="module")
 def reports(tmp_path_factory):
     """gps_qmcpf and hspf_ungm at 2 runs each, rebuilt by ``python -m replication.report`` (PDF, screenshot)."""

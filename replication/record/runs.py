@@ -52,7 +52,7 @@ def row(run: Run, record: dict | None, failure: str | None, series: tuple[str, .
     per-frame ``series`` kept, the others left out), or its ``failure``."""
     head = {"experiment": run.experiment, "method": run.method, "repetition": run.repetition,
             "run_key": run.key, "base_seed": run.base_seed, **run.condition.columns()}
-    head.update({k: v for k, v in parameters(run).items() if k.startswith(PARAMETERS)})
+    head.update({k: v for k, v in parameters([run]).iloc[0].items() if k.startswith(PARAMETERS)})
     if record is None:
         return {**head, FAILURE: failure}
     kept = {k: v for k, v in record.items() if k not in head and k not in LABELS and (k not in SERIES or k in series)}

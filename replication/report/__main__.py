@@ -24,12 +24,14 @@ from hydra import compose, initialize_config_dir
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.record.manifest import PAGES, Manifest
+from replication.record.manifest import MANIFEST, PAGES, Manifest
 from replication.record.runs import Record
+from replication.report.findings import Drawn, inputs, write_html, write_pages
+from replication.report.findings import render as render_findings
 from replication.report.pages.experiment import write_experiment_report
 from replication.report.pages.index import write_index
 from replication.report.pages.multiverse import write_multiverse_report
-from replication.report.pages.recorded import write_status
+from replication.report.pages.recorded import STATUS, write_status
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
@@ -104,12 +106,23 @@ def main(argv: list[str]) -> None:
             print(f"{name}: {page}")
         reports = resolve(cfg.reports)
         if source == "record":
-            print(f"status: {write_status(reports, Manifest.read(resolve(cfg.record)), stale)}")
+            held = resolve(cfg.record)
+            drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates").items()
+                          if k != "templates"}
+            print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
         if switches["pdf"]:
             from replication.report.pdf import write_pdf
 
             print(f"pdf: {write_pdf(reports, cfg.published_values)}")
         index = write_index(reports, cfg.published_values)
+        templates = resolve(cfg.findings) / "templates"
+        if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
+            try:  # rendered from the index's claims.csv and summary.csv, then linked from it
+                for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
+                    print(f"findings: {page}")
+                index = write_index(reports, cfg.published_values)
+            except LookupError as error:
+                print(f"findings: not drawn: {error}", file=sys.stderr)
         print(f"index: {index}")
         if switches["screenshot"]:
             from replication.report.pages.render import browser, open_in_browser
@@ -122,6 +135,34 @@ def main(argv: list[str]) -> None:
                 print(f"screenshot: {seen['screenshot']}")
                 for line in seen["console"]:
                     print(f"console: {line}", file=sys.stderr)
+
+
+def findings(argv: list[str]) -> None:
+    """``pf-replicate findings [record=record] [reports=reports] [findings=docs/findings]``: each paper's
+    findings rendered from the record into ``<findings>/<paper>.md`` (:mod:`replication.report.findings`), its
+    pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code."""
+    import json
+
+    from omegaconf import OmegaConf
+
+    if {"--help", "-h"} & set(argv):
+        print(findings.__doc__)
+        return
+    settings = {**OmegaConf.load(CONF_DIR / "config.yaml"), **dict(a.partition("=")[::2] for a in argv)}
+    record, out = resolve(settings["record"]), resolve(settings["findings"])
+    if not (record / MANIFEST).exists():
+        fail(f"{record}: no record here (make record writes one from a paper-scale store)")
+    drawn, rendered_from = Drawn(resolve(settings["reports"]) / PAGES), inputs(record, out / "templates")
+    status = drawn.folder / STATUS
+    drawn_from = json.loads(status.read_text()).get("drawn_from") if status.exists() else None
+    if drawn_from != {k: v for k, v in rendered_from.items() if k != "templates"}:  # another record, or code
+        main(["source=record", "pdf=false", *argv])
+    try:
+        pages = render_findings(drawn, out / "templates")
+    except LookupError as error:
+        fail(str(error))
+    for page in write_pages(pages, out, rendered_from):
+        print(f"findings: {page}")
 
 
 def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -> tuple[list[str], list[str]]:

@@ -7,7 +7,7 @@ count table per likelihood call, an N x N potential table per MRF pair).
 glibc serves blocks over its mmap threshold (128 kB at first) with fresh
 ``mmap`` pages and trims the heap's free top back to the OS, so each frame
 page-faults those arrays in again; in this machine's VM that made the bis_pf
-runs 2-3 times slower (see the README's "Speed").  Raising both thresholds
+runs 2-3 times slower (docs/vision.md, "Speed").  Raising both thresholds
 (``mallopt``, M_MMAP_THRESHOLD and M_TRIM_THRESHOLD: the same effect as the
 ``MALLOC_MMAP_THRESHOLD_`` and ``MALLOC_TRIM_THRESHOLD_`` environment
 variables, but settable after start, in any worker) lets the heap reuse them.

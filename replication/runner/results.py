@@ -92,10 +92,11 @@ class Results:
         return ["runs.parquet", "runs.csv", "frames.parquet"]
 
 
-def parameters(run: Run) -> dict:
-    """A run's parameters as flat columns ``method.<key>`` and ``model.<key>`` (nested keys joined by dots)."""
-    flat = pd.json_normalize({"method": run.method_params, "model": run.model}, sep=".")
-    return {"run_key": run.key, **flat.iloc[0].to_dict()}
+def parameters(runs: list[Run]) -> pd.DataFrame:
+    """The runs' parameters, a row per run keyed by ``run_key``, as flat columns ``method.<key>`` and
+    ``model.<key>`` (nested keys joined by dots)."""
+    flat = pd.json_normalize([{"method": run.method_params, "model": run.model} for run in runs], sep=".")
+    return flat.assign(run_key=[run.key for run in runs])[["run_key", *flat]]
 
 
 def tidy(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
@@ -103,7 +104,7 @@ def tidy(records: pd.DataFrame, runs: list[Run]) -> pd.DataFrame:
     the run's identity first, then its parameters, then its metrics and provenance."""
     if records.empty:
         return records
-    table = pd.DataFrame([parameters(run) for run in runs]).drop_duplicates("run_key")
+    table = parameters(runs).drop_duplicates("run_key")
     records = records.drop(columns=[c for c in SERIES if c in records])
     by_part = sorted(table, key=lambda column: column.split(".")[0])  # method.* before model.*
     columns = dict.fromkeys([*IDENTITY, "run_id", *by_part, *records])  # in that order, each once

@@ -15,6 +15,7 @@ import replication
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.evidence.claims import load_papers
 from replication.evidence.published import load_published
+from replication.record.manifest import PAGES
 from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
@@ -50,6 +51,15 @@ def _entry(name: str, summary: Summary) -> dict:
             "own": summary.own}  # and a user's own data or settings
 
 
+def _findings(reports: Path, paper: str) -> str | None:
+    """The link to the paper's findings at the papers' scale, from ``reports`` (the record's pages or the
+    report above them), where they were drawn."""
+    for link in (f"findings/{paper}.html", f"{PAGES}/findings/{paper}.html"):
+        if (reports / link).exists():
+            return link
+    return None
+
+
 def write_index(reports: Path, published_values: str | Path | None = None) -> Path:
     reports = Path(reports)
     summaries = load_summaries(reports)
@@ -75,7 +85,8 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
             missing=missing,
             cells=cells.to_dict("records"),
             papers=[{"paper": paper, "claims": rows[paper.key], "tally": tally(rows[paper.key]),
-                     "cells": int((cells["paper"] == paper.key).sum())} for paper in papers],
+                     "cells": int((cells["paper"] == paper.key).sum()), "findings": _findings(reports, paper.key)}
+                    for paper in papers],
             scale_note=_scale_note(summaries),
             record=record,
             tallies=tallies,

@@ -18,11 +18,14 @@ from replication.record.manifest import PAGES, RECOMPUTED, Manifest
 STATUS = "status.json"
 
 
-def write_status(out: Path, manifest: Manifest, stale: dict[str, int]) -> Path:
-    """``<out>/status.json``: the manifest's account of the runs drawn, and per experiment how many of its
-    recorded runs other code or settings than this checkout's made (``stale``)."""
+def write_status(out: Path, manifest: Manifest, stale: dict[str, int], drawn_from: dict[str, str]) -> Path:
+    """``<out>/status.json``: the manifest's account of the runs drawn, per experiment how many of its
+    recorded runs other code or settings than this checkout's made (``stale``), and what the pages were
+    drawn from (``drawn_from``: the manifest's SHA-256 and the drawing code's digest, so that pages of
+    another record or code are drawn again before findings are rendered from them)."""
     entries = {name: manifest.experiments[name] for name in stale}
     status = {
+        "drawn_from": drawn_from,
         "runs": sum(e.runs for e in entries.values()),
         "failed": sum(e.failed for e in entries.values()),
         "cpu_hours": round(sum(e.wall_s for e in entries.values()) / 3600, 1),

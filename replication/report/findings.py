@@ -1,0 +1,272 @@
+"""Each paper's findings, rendered from the paper-scale record into ``docs/findings/<paper>.md`` (and
+``index.md``) and the record's report pages, never typed (``pf-replicate findings``:
+:func:`replication.report.__main__.findings`).
+
+A paper's page is a hand-written Jinja template, ``docs/findings/templates/<paper>.md.j2``: the prose that
+explains (what the paper leaves open, what we chose and why, why a number differs from the paper's), with
+every number it quotes taken from the record's drawn pages (``<reports>/record``: ``claims.csv``,
+``summary.csv``, each experiment's table CSVs and ``status.json``) through these names:
+
+- ``claim("bis_pf.time")``: a claim's row (``.verdict``, ``.estimate`` "value [low, high]", ``.runs``,
+  ``.why``, ``.robustness``, ``.at_equal_cost``);
+- ``table("bis_pf", "table2_error").at(method="BIS-PF", condition="scene=exp2_16_targets")``: one row of a
+  table (``.ours``, ``.estimate``, any column by name: ``row["failed runs"]``), its numbers shown to 4
+  significant digits; ``.rows`` every row;
+- ``experiment("bis_pf")``: its runs, minutes and CPU-minutes as recorded;
+- ``scorecard()``, ``cells()``, ``times()``: the paper's claims, its published cells beside ours, and its
+  experiments' cost, as Markdown tables.
+
+A row a template names that the record does not hold stops the rendering with one line naming it.
+:data:`RENDERED` records what the pages were rendered from (the record, the templates, the code) so that a
+check costs no drawing: :func:`stale` says why pages no longer match (``tests/test_findings.py``).
+"""
+
+import hashlib
+import json
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import jinja2
+import pandas as pd
+
+from replication.evidence.claims import Paper, load_papers
+from replication.record.manifest import MANIFEST, sha256
+from replication.report.pages.recorded import STATUS
+from replication.runner.provenance import run_code_digest
+
+RENDERED = "rendered.json"  # beside the pages: what they were rendered from, and each page's SHA-256
+
+
+def number(value) -> str:
+    """A number as the findings show it: 4 significant digits, thousands whole; '' when not finite."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    if isinstance(value, str):
+        return value
+    return f"{value:,.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
+
+
+def estimate(value, low, high) -> str:
+    """'value [low, high]', or the value alone where the interval is not defined."""
+    if any(v is None or not math.isfinite(v) for v in (low, high)):
+        return number(value)
+    return f"{number(value)} [{number(low)}, {number(high)}]"
+
+
+def _cell(value):
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+@dataclass(frozen=True)
+class Row:
+    """One row of a drawn table: columns by name (numbers shown as :func:`number` shows them)."""
+
+    where: str
+    values: dict
+
+    def __getitem__(self, column: str) -> str:
+        if column not in self.values:
+            raise LookupError(f"{self.where} has no column {column!r}; it has {', '.join(self.values)}")
+        return number(_cell(self.values[column]))
+
+    def __getattr__(self, column: str) -> str:
+        if column.startswith("_"):
+            raise AttributeError(column)
+        return self[column]
+
+    @property
+    def estimate(self) -> str:
+        v = self.values
+        return estimate(*(_cell(v.get(k)) for k in ("ours", "ci_low", "ci_high")))
+
+
+@dataclass(frozen=True)
+class Table:
+    where: str
+    frame: pd.DataFrame
+
+    @property
+    def rows(self) -> list[Row]:
+        return [Row(f"{self.where} row {i}", row) for i, row in enumerate(self.frame.to_dict("records"))]
+
+    def at(self, **match) -> Row:
+        """The one row whose columns equal ``match``."""
+        picked = self.frame
+        for column, value in match.items():
+            if column not in picked:
+                raise LookupError(f"{self.where} has no column {column!r}")
+            picked = picked[picked[column].astype(str) == str(value)]
+        where = f"{self.where} at {', '.join(f'{k}={v}' for k, v in match.items())}"
+        if len(picked) != 1:
+            raise LookupError(f"{where}: {len(picked)} rows, not one")
+        return Row(where, picked.iloc[0].to_dict())
+
+
+@dataclass(frozen=True)
+class Drawn:
+    """The record's drawn pages (``<reports>/record``) as the templates read them."""
+
+    folder: Path
+
+    @property
+    def status(self) -> dict:
+        return json.loads((self.folder / STATUS).read_text())
+
+    @property
+    def claims(self) -> pd.DataFrame:
+        return pd.read_csv(self.folder / "claims.csv", keep_default_na=False, na_values=[""])
+
+    @property
+    def cells(self) -> pd.DataFrame:
+        return pd.read_csv(self.folder / "summary.csv", keep_default_na=False, na_values=[""], dtype={"ours": str})
+
+    def table(self, experiment: str, name: str) -> Table:
+        path = self.folder / experiment / f"{name}.csv"
+        if not path.exists():
+            raise LookupError(f"the record's pages have no table {experiment}/{name}")
+        return Table(f"{experiment}/{name}", pd.read_csv(path))
+
+    def experiments_of(self, paper: str) -> list[str]:
+        """The paper's experiments the record holds, by their summaries."""
+        return [p.parent.name for p in sorted(self.folder.glob("*/summary.json"))
+                if json.loads(p.read_text())["paper"] == paper]
+
+
+def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
+    """The names a template may use (see the module's docstring); ``paper`` its paper's key (or ``index``)."""
+    claims = drawn.claims.set_index("claim_id", drop=False)
+    status = drawn.status
+
+    def claim(claim_id: str) -> dict:
+        if claim_id not in claims.index:
+            raise LookupError(f"the record has no claim {claim_id!r}")
+        c = {k: _cell(v) for k, v in claims.loc[claim_id].to_dict().items()}
+        return {**c, "verdict": c["verdict"], "why": c["reason"], "runs": number(c["runs"]),
+                "estimate": estimate(c["number"], c["ci_low"], c["ci_high"]) if c["number"] is not None else ""}
+
+    def experiment(name: str) -> dict:
+        if name not in status["experiments"]:
+            raise LookupError(f"the record holds no experiment {name!r}")
+        return {k: number(v) for k, v in status["experiments"][name].items()}
+
+    def scorecard() -> str:
+        rows = claims[claims["paper"] == paper]
+        header = ["claim", "verdict", "deciding", "estimate [90% interval]", "runs", "under every reading"]
+        return markdown_table(header,
+                              [[f"`{c}`: {t}", f"**{v}**", d or "", estimate(n, lo, hi) if n == n else "",
+                                number(r) if r == r else "", rb or ""]
+                               for c, t, v, d, n, lo, hi, r, rb in rows[
+                                   ["claim_id", "claim", "verdict", "deciding", "number", "ci_low", "ci_high", "runs",
+                                    "robustness"]].itertuples(index=False)])
+
+    def cells() -> str:
+        rows = drawn.cells[drawn.cells["paper"] == paper].fillna("")
+        return markdown_table(["table", "method", "condition", "metric", "paper", "ours", "runs", "verdict"],
+                              [[t, m, c, mt, p, number(_float(o)), number(_float(r)), v] for t, m, c, mt, p, o, r, v
+                               in rows[["table", "method", "condition", "metric", "paper_value", "ours", "runs",
+                                        "verdict"]].itertuples(index=False)])
+
+    def verdicts(key: str) -> str:
+        counted = claims[claims["paper"] == key]["verdict"].value_counts()
+        return ", ".join(f"{n} {verdict}" for verdict, n in counted.items())
+
+    def times() -> str:
+        names = drawn.experiments_of(paper) if paper in papers else list(status["experiments"])
+        return markdown_table(["experiment", "runs", "minutes (2 workers)", "CPU-minutes"],
+                              [[f"`{n}`", *(experiment(n)[k] for k in ("runs", "minutes", "cpu_minutes"))]
+                               for n in names if n in status["experiments"]])
+
+    return {"paper": papers.get(paper), "papers": papers, "page": paper,
+            "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
+            "claim": claim, "table": drawn.table, "experiment": experiment, "verdicts": verdicts,
+            "scorecard": scorecard, "cells": cells, "times": times}
+
+
+def _float(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return text or None
+
+
+def markdown_table(header: list[str], rows: list[list]) -> str:
+    def clean(value) -> str:
+        return str(value).replace("|", "\\|").replace("\n", " ")
+
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return "\n".join(lines + ["| " + " | ".join(clean(v) for v in row) + " |" for row in rows])
+
+
+def render(drawn: Drawn, templates: Path) -> dict[str, str]:
+    """Each template of ``templates`` rendered: its page's name (``bis_pf``, ``index``) -> Markdown."""
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(templates), undefined=jinja2.StrictUndefined,
+                             keep_trailing_newline=True, autoescape=False)
+    papers = {paper.key: paper for paper in load_papers()}
+    pages = {}
+    for path in sorted(Path(templates).glob("[!_]*.md.j2")):  # _name.md.j2: a part the pages include
+        name = path.name.removesuffix(".md.j2")
+        try:
+            pages[name] = env.get_template(path.name).render(**context(drawn, name, papers))
+        except (LookupError, AttributeError, jinja2.UndefinedError) as error:
+            raise LookupError(f"{path.name}: {error}") from None
+    return pages
+
+
+def inputs(record: Path, templates: Path) -> dict[str, str]:
+    """What the pages are rendered from, each as a digest: the record (its manifest's SHA-256, which holds
+    every file's), the templates, and the code that draws the record's pages and renders them (every module
+    the report's command imports)."""
+    text = hashlib.sha256()
+    for path in sorted(Path(templates).glob("*.md.j2")):
+        text.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return {"record": sha256(Path(record) / MANIFEST), "templates": text.hexdigest(),
+            "code": run_code_digest(("report/__main__.py",))}
+
+
+def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str]) -> list[Path]:
+    """The pages as ``<out>/<name>.md``, and :data:`RENDERED`: their inputs and each page's SHA-256."""
+    written = []
+    for name, text in pages.items():
+        written.append(out / f"{name}.md")
+        written[-1].write_text(text)
+    digests = {name: hashlib.sha256(text.encode()).hexdigest() for name, text in pages.items()}
+    (out / RENDERED).write_text(json.dumps({"inputs": rendered_from, "pages": digests}, indent=1) + "\n")
+    return written
+
+
+def stale(out: Path, rendered_from: dict[str, str]) -> list[str]:
+    """Why the pages in ``out`` are not what the record renders today: an input changed since they were
+    rendered (the record, the templates, the code), or a page was edited, added or removed by hand."""
+    if not (out / RENDERED).exists():
+        return [f"{out / RENDERED} is missing"]
+    written = json.loads((out / RENDERED).read_text())
+    reasons = [f"the {name} changed since they were rendered" for name, digest in rendered_from.items()
+               if written["inputs"].get(name) != digest]
+    on_disk = {p.stem: hashlib.sha256(p.read_bytes()).hexdigest() for p in out.glob("*.md")}
+    reasons += [f"{name}.md was edited by hand" for name in on_disk.keys() & written["pages"].keys()
+                if on_disk[name] != written["pages"][name]]
+    reasons += [f"{name}.md is not rendered" for name in on_disk.keys() ^ written["pages"].keys()]
+    return reasons
+
+
+def write_html(pages: dict[str, str], out: Path) -> list[Path]:
+    """The rendered pages as HTML in the report's style, under ``out`` (``<reports>/record/findings``); links
+    to sibling pages point at their HTML."""
+    from markdown_it import MarkdownIt
+    from markupsafe import Markup
+
+    from replication.report.pages.render import render as render_page
+
+    markdown = MarkdownIt("commonmark").enable("table")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, text in pages.items():
+        body = re.sub(r'href="([\w-]+)\.md"', r'href="\1.html"', markdown.render(text))
+        title = next((line[2:] for line in text.splitlines() if line.startswith("# ")), name)
+        path = out / f"{name}.html"
+        path.write_text(render_page("findings.html.j2", title=title, body=Markup(body)))
+        written.append(path)
+    return written
+

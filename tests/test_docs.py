@@ -1,0 +1,99 @@
+"""The README and the hand-written docs type no result by hand, and every link in them resolves.
+
+Results reach a reader from the record, rendered (``docs/findings/``, checked against the record by
+``tests/test_findings.py``); a number typed into prose goes stale with the next change of code.  A *result
+number* here is a decimal (``24.6``, ``1e-86``), a percentage (``31 %``) or a duration (``7 min``,
+``13.6 ms``) outside a fenced code block.  One may stand in a hand-written file only when it is a paper's
+own published value (``published_values.csv``: it never goes stale), a setting written as one
+(``sigma = 0.1``), a section of a paper (``section 5.2``), a setting of the statistics (a confidence
+level), or a figure about the project in :data:`ALLOWED`, each with what it is and the date it was
+measured.  The tutorials are left to ``tests/test_tutorials.py``, which runs them and checks every number
+they quote; the CHANGELOG is history, dated by its entries.
+"""
+
+import csv
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PUBLISHED = ROOT.parent / "shared" / "reference" / "published_values.csv"
+TUTORIALS = {"tutorial_state_space.md", "tutorial_video.md"}
+
+NUMBER = re.compile(
+    r"(?<![\w.\-/=#:])(?<!= )(?<!section )("
+    r"\d+(?:\.\d+)?e-?\d+"                                          # 1e-86
+    r"|\d+(?:\.\d+)?\s?%"                                           # 31 %, 4.6%
+    r"|\d+(?:\.\d+)?\s?(?:ms|s|min|h|hours|minutes|seconds)\b"      # 7 min, 13.6 ms
+    r"|\d+\.\d+"                                                    # 24.6
+    r")(?![\w.]*\d)")
+CONFIDENCE = re.compile(r"(?:5|10|80|90|95)\s?%")  # the statistics' levels: settings, not results
+
+# Figures about the project a hand-written file may hold: the text, and what it is (with its date).
+ALLOWED: dict[str, str] = {
+    "3.11": "the Python version the project needs",
+    "7 minutes": "README: `make test` from a fresh clone with an empty HOME on the 2-core machine, creating "
+                 "the venv included (6 min 55 s, measured 2026-11-26)",
+    "6 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
+                 "(5 min 45 s, measured 2026-11-26)",
+}
+
+
+def hand_written() -> list[Path]:
+    docs = [p for p in (ROOT / "docs").rglob("*.md") if p.name not in TUTORIALS
+            and p.parent != ROOT / "docs" / "findings"]
+    return [ROOT / "README.md", *sorted(docs), *sorted((ROOT / "docs").rglob("*.md.j2"))]
+
+
+def prose(text: str) -> str:
+    """``text`` without its fenced code blocks (commands and their settings) and its link targets."""
+    text = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)
+    return re.sub(r"\]\([^)]*\)", "]", text)
+
+
+def paper_values() -> set[str]:
+    with PUBLISHED.open() as f:
+        return {row["value"].strip() for row in csv.DictReader(f)}
+
+
+def typed_results(text: str, published: set[str]) -> list[str]:
+    found = []
+    for match in NUMBER.finditer(prose(text)):
+        token = match.group(1)
+        bare = re.sub(r"\s?(%|ms|s|min|h|hours|minutes|seconds)$", "", token)
+        if token in ALLOWED or bare in published or CONFIDENCE.fullmatch(token):
+            continue
+        found.append(token)
+    return found
+
+
+@pytest.mark.parametrize("path", hand_written(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_a_hand_written_page_types_no_result(path):
+    if not PUBLISHED.exists():
+        pytest.skip("../shared/reference is not beside this clone")
+    typed = typed_results(path.read_text(), paper_values())
+    assert not typed, f"{path.relative_to(ROOT)} types results by hand (render them from the record): {typed[:20]}"
+
+
+def test_the_result_rule_finds_typed_results_and_spares_the_rest():
+    text = ("BIS-PF errs by 24.6 px, 31 % of frames, in 7 min; F is about 1e-86.  The paper's 5.52 fps.\n"
+            "A 95% interval, 16 universes, 20 px, N = 100, sigma = 0.1, section 1.2.\n"
+            "```sh\nmake verify N=200 sigma=0.05\n```\n"
+            "[a link](docs/x-1.5.md) in Python 3.11.\n")
+    assert typed_results(text, {"5.52"}) == ["24.6", "31 %", "7 min", "1e-86"]
+
+
+LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+
+
+@pytest.mark.parametrize("path", [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))],
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_link_resolves(path):
+    broken = []
+    for target in LINK.findall(path.read_text()):
+        if re.match(r"[a-z]+:", target) or target.startswith("#"):  # the web, mail, an anchor on the page
+            continue
+        if not (path.parent / target.split("#")[0]).exists():
+            broken.append(target)
+    assert not broken, f"{path.relative_to(ROOT)} links to what is not there: {broken}"

@@ -1,0 +1,142 @@
+"""Each paper's findings are rendered from the record, never typed: ``docs/findings/`` is what the shipped
+record renders (a changed record without regenerated findings fails here), a template naming what the
+record lacks fails in one line, and the numbers are shown as the report shows them."""
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from replication.paths import PACKAGE_DIR
+from replication.record.manifest import MANIFEST, PAGES, sha256
+from replication.report.__main__ import findings, main as report
+from replication.report.findings import Drawn, estimate, inputs, number, render, stale, write_html, write_pages
+
+ROOT = PACKAGE_DIR.parent
+FINDINGS = ROOT / "docs" / "findings"
+
+
+@pytest.fixture(scope="module")
+def shipped_pages(tmp_path_factory):
+    """The shipped record's pages, drawn as ``report source=record`` draws them."""
+    if not (ROOT.parent / "shared" / "reference" / "published_values.csv").exists():
+        pytest.skip("../shared/reference is not beside this clone")
+    reports = tmp_path_factory.mktemp("reports")
+    report(["source=record", f"record={ROOT / 'record'}", f"reports={reports}", "pdf=false", "outside_project=true"])
+    return reports
+
+
+def test_the_findings_on_disk_were_rendered_from_this_record_these_templates_and_this_code():
+    why = stale(FINDINGS, inputs(ROOT / "record", FINDINGS / "templates"))
+    assert not why, f"docs/findings/ is stale ({'; '.join(why)}): run make findings"
+
+
+def test_a_changed_input_or_a_page_edited_by_hand_makes_the_findings_stale(tmp_path):
+    rendered_from = {"record": "a", "templates": "b", "code": "c"}
+    write_pages({"p": "# P\n", "index": "# all\n"}, tmp_path, rendered_from)
+    assert stale(tmp_path, rendered_from) == []
+    assert stale(tmp_path, {**rendered_from, "record": "z"}) == ["the record changed since they were rendered"]
+    (tmp_path / "p.md").write_text("# P, better\n")
+    (tmp_path / "q.md").write_text("# Q\n")
+    assert stale(tmp_path, rendered_from) == ["p.md was edited by hand", "q.md is not rendered"]
+
+
+@pytest.mark.slow  # draws every page of the record (about 2 minutes); the test above checks the same inputs
+def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages):
+    pages = render(Drawn(shipped_pages / PAGES), FINDINGS / "templates")
+    on_disk = {p.stem: p.read_text() for p in FINDINGS.glob("*.md")}  # drawn by the code and record of today
+    assert set(pages) == set(on_disk) == {"index", "ism_pf", "bis_pf", "gps_qmcpf", "fusion_pf", "hspf"}
+    stale = [name for name in pages if pages[name] != on_disk[name]]
+    assert not stale, f"docs/findings/ differs from what the record renders for {stale}: run pf-replicate findings"
+    assert (shipped_pages / PAGES / "findings" / "bis_pf.html").exists()  # and the record's pages show them
+    status = json.loads((shipped_pages / PAGES / "status.json").read_text())
+    assert status["drawn_from"]["record"] == sha256(ROOT / "record" / MANIFEST)
+    assert f"{status['runs']:,} runs" in pages["index"]
+
+
+def _drawn(tmp_path: Path) -> Drawn:
+    folder = tmp_path / "pages"
+    (folder / "exp").mkdir(parents=True)
+    (folder / "claims.csv").write_text("paper,claim_id,claim,verdict,reason,number,ci_low,ci_high,runs,deciding,"
+                                       "robustness\np,p.a,A beats B,reproduced,2 of 2 checks hold,0.123456,0.1,"
+                                       "0.15,20,A - B,one reading\n")
+    (folder / "summary.csv").write_text("paper,table,method,condition,metric,paper_value,ours,runs,verdict\n"
+                                        "p,1,A,N=1,rmse,4.2,4.25,20,reproduced\n")
+    (folder / "exp" / "t.csv").write_text("method,condition,ours,ci_low,ci_high,failed runs\n"
+                                          "A,N=1,12345.6,,,3\nB,N=1,0.5,0.25,0.75,0\n")
+    (folder / "exp" / "summary.json").write_text(json.dumps({"paper": "p"}))
+    (folder / "status.json").write_text(json.dumps({"runs": 40, "experiments": {
+        "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0}}}))
+    return Drawn(folder)
+
+
+def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path):
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / "p.md.j2").write_text(
+        '{{ claim("p.a").verdict }}: {{ claim("p.a").estimate }}; {% set t = table("exp", "t") -%}'
+        '{{ t.at(method="A").ours }} {{ t.at(method="B").estimate }} {{ t.at(method="A")["failed runs"] }}; '
+        '{{ experiment("exp").minutes }}\n{{ scorecard() }}\n{{ cells() }}\n{{ times() }}\n')
+    page = render(_drawn(tmp_path), tmp_path / "t")["p"]
+    first, *tables = page.splitlines()
+    assert first == "reproduced: 0.1235 [0.1, 0.15]; 12,346 0.5 [0.25, 0.75] 3; 1.25"
+    assert "| `p.a`: A beats B | **reproduced** | A - B | 0.1235 [0.1, 0.15] | 20 | one reading |" in tables
+    assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
+    assert "| `exp` | 40 | 1.25 | 2.5 |" in tables
+
+
+@pytest.mark.parametrize("template, named", [
+    ('{{ claim("p.zz").verdict }}', "no claim 'p.zz'"),
+    ('{{ table("exp", "t").at(method="C").ours }}', "exp/t at method=C: 0 rows, not one"),
+    ('{{ table("exp", "t").at(method="A").nope }}', "exp/t at method=A has no column 'nope'"),
+    ('{{ table("exp", "gone").rows }}', "no table exp/gone"),
+    ('{{ undefined_name }}', "'undefined_name' is undefined"),
+])
+def test_a_template_naming_what_the_record_lacks_fails_naming_it(tmp_path, template, named):
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / "p.md.j2").write_text(template)
+    with pytest.raises(LookupError, match="p.md.j2: .*" + named.replace("(", r"\(")):
+        render(_drawn(tmp_path), tmp_path / "t")
+
+
+def test_numbers_are_shown_to_four_digits_and_an_interval_only_where_it_is_defined():
+    assert [number(v) for v in (0.123456, 4.5, 1234.5, 12345.6, float("nan"), None)] == \
+        ["0.1235", "4.5", "1234", "12,346", "", ""]
+    assert estimate(4.25, 4.0, 4.5) == "4.25 [4, 4.5]"
+    assert estimate(4.25, None, 4.5) == estimate(4.25, float("nan"), 4.5) == "4.25"
+
+
+def test_the_html_pages_link_to_each_other(tmp_path):
+    written = write_html({"p": "# P\n\n[All papers](index.md), [x](https://example.org/a.md)\n\n| a |\n|---|\n| 1 |\n"},
+                         tmp_path)
+    html = written[0].read_text()
+    assert '<a href="index.html">All papers</a>' in html and 'href="https://example.org/a.md"' in html
+    assert "<table>" in html and "<title>P</title>" in html
+
+
+def test_findings_without_a_record_is_one_line(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stopped:
+        findings([f"record={tmp_path}", f"findings={tmp_path}"])
+    assert stopped.value.code == 2
+    assert "no record here" in capsys.readouterr().err
+
+
+def test_findings_writes_the_pages_and_draws_the_record_only_when_needed(tmp_path, monkeypatch, capsys):
+    pages = _drawn(tmp_path).folder
+    record, reports, out = tmp_path / "record", tmp_path / "reports", tmp_path / "findings"
+    record.mkdir()
+    (record / MANIFEST).write_text("{}")
+    shutil.copytree(pages, reports / PAGES)
+    (out / "templates").mkdir(parents=True)
+    drawn_from = {k: v for k, v in inputs(record, out / "templates").items() if k != "templates"}
+    status = json.loads((reports / PAGES / "status.json").read_text())
+    (reports / PAGES / "status.json").write_text(json.dumps({**status, "drawn_from": drawn_from}))
+    (out / "templates" / "p.md.j2").write_text('{{ claim("p.a").verdict }}\n')
+    drew = []
+    monkeypatch.setattr("replication.report.__main__.main", lambda argv: drew.append(argv))
+    findings([f"record={record}", f"reports={reports}", f"findings={out}"])
+    assert (out / "p.md").read_text() == "reproduced\n" and not drew
+    assert stale(out, inputs(record, out / "templates")) == []
+    (record / MANIFEST).write_text('{"changed": 1}')  # another record: its pages are drawn again first
+    findings([f"record={record}", f"reports={reports}", f"findings={out}"])
+    assert drew and "source=record" in drew[0]
