@@ -237,12 +237,15 @@ def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically
 def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):
     from replication.report.diff import main as diff
 
-    claims = pd.DataFrame({"claim_id": ["p.a", "p.b"], "verdict": ["holds", "inconclusive"],
-                           "number": ["1.2 [0.5, 1.9]", "0.1 [-0.3, 0.5]"], "runs": ["10", "10"]})
+    claims = pd.DataFrame({"claim_id": ["p.a", "p.b", "p.c"], "verdict": ["holds", "inconclusive", "holds"],
+                           "number": ["1.2 [0.5, 1.9]", "0.1 [-0.3, 0.5]", "3"], "runs": ["10", "10", "10"],
+                           "robustness": ["robust", "robust", "one reading"]})
     cells = pd.DataFrame({"paper": ["p"], "table": ["1"], "experiment": ["e"], "method": ["PF"], "metric": ["rmse"],
                           "condition": ["N=100"], "ours": ["4.1 [3.9, 4.3]"], "verdict": ["reproduced"]})
     for name, (c, s) in {"a": (claims, cells),
-                         "b": (claims.assign(verdict=["holds", "does not hold"]), cells.assign(ours="4.2 [4.0, 4.4]"))
+                         "b": (claims.assign(verdict=["holds", "does not hold", "holds"],
+                                             robustness=["robust", "robust", "no reading moves the verdict "]),
+                               cells.assign(ours="4.2 [4.0, 4.4]"))
                          }.items():
         (tmp_path / name).mkdir()
         c.to_csv(tmp_path / name / "claims.csv", index=False)
@@ -251,7 +254,8 @@ def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsy
     out = capsys.readouterr().out
     assert "p.b: verdict 'inconclusive' -> 'does not hold'" in out and "p.a:" not in out
     assert "p 1 e PF rmse N=100: ours '4.1 [3.9, 4.3]' -> '4.2 [4.0, 4.4]'" in out
-    assert "2 claims: 1 changed verdict, 1 changed at all; 1 cells: 1 changed" in out
+    assert "p.c: robustness 'one reading' -> 'no reading moves the verdict '" in out
+    assert "3 claims: 1 changed verdict, 2 changed at all; 1 cells: 1 changed" in out  # p.c's verdict held
     with pytest.raises(SystemExit):
         diff([str(tmp_path / "a"), str(tmp_path / "nothing")])
 

@@ -20,6 +20,7 @@ import sys
 from pathlib import Path
 
 from hydra import compose, initialize_config_dir
+from joblib import Parallel, delayed
 
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
@@ -72,69 +73,79 @@ def main(argv: list[str]) -> None:
         fail(f"source must be one of {', '.join(SOURCES)}, got {source!r}")
     if source == "record":
         names, overrides = recorded_experiments(names, overrides, bool(chosen))
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # the settings: workers, folders
+        cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
+    try:  # each experiment's pages on its own worker (the order of the output is the experiments')
+        drawn = Parallel(n_jobs=cfg.n_jobs)(delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+    except ConfigError as error:
+        fail(str(error))
     stale = {}  # drawn from the record: per experiment, its recorded runs that other code made
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        for name in names:
-            try:
-                check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
-            except ConfigError as error:
-                if chosen:  # named on the command line: the user wants to know
-                    fail(str(error))
-                print(f"skipped: {error}", file=sys.stderr)  # one broken file never breaks the others
-                continue
-            cfg = compose("config", overrides=[f"experiment={name}", *overrides])
-            try:
-                configure(cfg.inference)
-                if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
-                    multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
-                    page = write_multiverse_report(cfg, multiverse, tuple(overrides),
-                                                   lambda name, u: record.universe(multiverse.name, u.name))
-                    stale[name] = sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
-                                      for u in multiverse.universes for e in multiverse.experiments)
-                elif "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
-                    page = write_multiverse_report(cfg, load_multiverse(cfg), tuple(overrides))
-                else:
-                    if source == "record":
-                        store = Record(resolve(cfg.record))
-                        results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
-                        stale[name] = len(store.stale(results.runs))
-                    else:
-                        results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
-                    page = write_experiment_report(cfg, results)
-            except ConfigError as error:
-                fail(str(error))
+    for name, page, stale_runs in drawn:
+        if page is not None:
             print(f"{name}: {page}")
-        reports = resolve(cfg.reports)
+        if stale_runs is not None:
+            stale[name] = stale_runs
+    reports = resolve(cfg.reports)
+    if source == "record":
+        held = resolve(cfg.record)
+        drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates").items()
+                      if k != "templates"}
+        print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
+    if switches["pdf"]:
+        from replication.report.pdf import write_pdf
+
+        print(f"pdf: {write_pdf(reports, cfg.published_values)}")
+    index = write_index(reports, cfg.published_values)
+    templates = resolve(cfg.findings) / "templates"
+    if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
+        try:  # rendered from the index's claims.csv and summary.csv, then linked from it
+            for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
+                print(f"findings: {page}")
+            index = write_index(reports, cfg.published_values)
+        except LookupError as error:
+            print(f"findings: not drawn: {error}", file=sys.stderr)
+    print(f"index: {index}")
+    if switches["screenshot"]:
+        from replication.report.pages.render import browser, open_in_browser
+
+        if browser() is None:
+            print("screenshot: skipped, no Chromium on the PATH (apt-get install chromium)",
+                  file=sys.stderr)
+        else:
+            seen = open_in_browser(index, reports / "screenshot.png")
+            print(f"screenshot: {seen['screenshot']}")
+            for line in seen["console"]:
+                print(f"console: {line}", file=sys.stderr)
+
+
+def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[str, Path | None, int | None]:
+    """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``): its name, its
+    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said) and, from the
+    record, how many of its recorded runs other code made."""
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        try:
+            check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
+        except ConfigError as error:
+            if chosen:  # named on the command line: the user wants to know
+                raise
+            print(f"skipped: {error}", file=sys.stderr)  # one broken file never breaks the others
+            return name, None, None
+        cfg = compose("config", overrides=[f"experiment={name}", *overrides])
+        configure(cfg.inference)
+        if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
+            multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
+            page = write_multiverse_report(cfg, multiverse, tuple(overrides),
+                                           lambda name, u: record.universe(multiverse.name, u.name))
+            return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
+                                   for u in multiverse.universes for e in multiverse.experiments)
+        if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
+            return name, write_multiverse_report(cfg, load_multiverse(cfg), tuple(overrides)), None
         if source == "record":
-            held = resolve(cfg.record)
-            drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates").items()
-                          if k != "templates"}
-            print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
-        if switches["pdf"]:
-            from replication.report.pdf import write_pdf
-
-            print(f"pdf: {write_pdf(reports, cfg.published_values)}")
-        index = write_index(reports, cfg.published_values)
-        templates = resolve(cfg.findings) / "templates"
-        if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
-            try:  # rendered from the index's claims.csv and summary.csv, then linked from it
-                for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
-                    print(f"findings: {page}")
-                index = write_index(reports, cfg.published_values)
-            except LookupError as error:
-                print(f"findings: not drawn: {error}", file=sys.stderr)
-        print(f"index: {index}")
-        if switches["screenshot"]:
-            from replication.report.pages.render import browser, open_in_browser
-
-            if browser() is None:
-                print("screenshot: skipped, no Chromium on the PATH (apt-get install chromium)",
-                      file=sys.stderr)
-            else:
-                seen = open_in_browser(index, reports / "screenshot.png")
-                print(f"screenshot: {seen['screenshot']}")
-                for line in seen["console"]:
-                    print(f"console: {line}", file=sys.stderr)
+            store = Record(resolve(cfg.record))
+            results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
+            return name, write_experiment_report(cfg, results), len(store.stale(results.runs))
+        results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
+        return name, write_experiment_report(cfg, results), None
 
 
 def findings(argv: list[str]) -> None:

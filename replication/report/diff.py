@@ -40,20 +40,28 @@ def drawn(source: str, scratch: Path) -> Path:
     fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no claims.csv and summary.csv) nor 'store'")
 
 
-def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...], fields: tuple[str, ...]) -> list[str]:
-    """One line per row (by ``key``) whose ``fields`` differ, or that only one side has."""
+def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...],
+            fields: tuple[str, ...]) -> list[tuple[str, dict[str, tuple[str, str]]]]:
+    """Each row (by ``key``, named by its key's values) whose ``fields`` differ, with each differing field's
+    (before, after), or that only one side has (its one field ``only in``: (the side, ''))."""
     joined = before.merge(after, on=list(key), how="outer", suffixes=("_a", "_b"), indicator=True)
-    lines = []
+    found = []
     for row in joined.fillna("").astype(str).to_dict("records"):
         name = " ".join(row[k] for k in key if row[k])
         if row["_merge"] != "both":
-            lines.append(f"{name}: only in {'A' if row['_merge'] == 'left_only' else 'B'}")
+            found.append((name, {"only in": ("A" if row["_merge"] == "left_only" else "B", "")}))
             continue
-        moved = [f"{f} {row[f + '_a'] or '-'!r} -> {row[f + '_b'] or '-'!r}" for f in fields
-                 if f + "_a" in row and row[f + "_a"] != row[f + "_b"]]
+        moved = {f: (row[f + "_a"], row[f + "_b"]) for f in fields
+                 if f + "_a" in row and row[f + "_a"] != row[f + "_b"]}
         if moved:
-            lines.append(f"{name}: " + "; ".join(moved))
-    return lines
+            found.append((name, moved))
+    return found
+
+
+def line(name: str, moved: dict[str, tuple[str, str]]) -> str:
+    if "only in" in moved:
+        return f"{name}: only in {moved['only in'][0]}"
+    return f"{name}: " + "; ".join(f"{f} {a or '-'!r} -> {b or '-'!r}" for f, (a, b) in moved.items())
 
 
 def main(argv: list[str]) -> None:
@@ -67,12 +75,13 @@ def main(argv: list[str]) -> None:
                    for source in argv]
         claims = [pd.read_csv(folder / "claims.csv", dtype=str) for folder in folders]
         cells = [pd.read_csv(folder / "summary.csv", dtype=str) for folder in folders]
-    claim_lines = changes(*claims, CLAIM, CLAIM_FIELDS)
-    cell_lines = changes(*cells, CELL, CELL_FIELDS)
+    claim_changes = changes(*claims, CLAIM, CLAIM_FIELDS)
+    claim_lines = [line(*change) for change in claim_changes]
+    cell_lines = [line(*change) for change in changes(*cells, CELL, CELL_FIELDS)]
     print(f"A: {argv[0]}\nB: {argv[1]}")
     for title, lines in (("claims", claim_lines), ("published cells", cell_lines)):
         print(f"\n{title}: {len(lines)} changed")
         print(*lines, sep="\n", end="\n" if lines else "")
-    verdicts = sum("verdict " in line for line in claim_lines)
+    verdicts = sum("verdict" in moved for _, moved in claim_changes)
     print(f"\n{len(claims[1])} claims: {verdicts} changed verdict, {len(claim_lines)} changed at all; "
           f"{len(cells[1])} cells: {len(cell_lines)} changed")
