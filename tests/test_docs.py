@@ -34,9 +34,9 @@ CONFIDENCE = re.compile(r"(?:5|10|80|90|95)\s?%")  # the statistics' levels: set
 ALLOWED: dict[str, str] = {
     "3.11": "the Python version the project needs",
     "7 minutes": "README: `make test` from a fresh clone with an empty HOME on the 2-core machine, creating "
-                 "the venv included (6 min 55 s, measured 2026-11-26)",
-    "6 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
-                 "(5 min 45 s, measured 2026-11-26)",
+                 "the venv included (6 min 56 s at 161a222, measured 2026-11-26)",
+    "9 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
+                 "(8 min 29 s at 161a222, measured 2026-11-26)",
 }
 
 
@@ -97,3 +97,15 @@ def test_every_link_resolves(path):
         if not (path.parent / target.split("#")[0]).exists():
             broken.append(target)
     assert not broken, f"{path.relative_to(ROOT)} links to what is not there: {broken}"
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "conf" / "claims").glob("*.yaml")), ids=lambda p: p.name)
+def test_a_claims_note_shown_on_every_page_types_no_result(path):
+    """A claim's note is prose the scorecard shows beside the verdict: its numbers come from the tables."""
+    import yaml
+
+    if not PUBLISHED.exists():
+        pytest.skip("../shared/reference is not beside this clone")
+    typed = {claim["id"]: found for claim in yaml.safe_load(path.read_text())["claims"]
+             if (found := typed_results(claim.get("note") or "", paper_values()))}
+    assert not typed, f"{path.name}: notes type results by hand: {typed}"

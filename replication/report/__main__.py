@@ -88,8 +88,8 @@ def main(argv: list[str]) -> None:
     reports = resolve(cfg.reports)
     if source == "record":
         held = resolve(cfg.record)
-        drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates").items()
-                      if k != "templates"}
+        drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates",
+                                              resolve(cfg.published_values)).items() if k != "templates"}
         print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
     if switches["pdf"]:
         from replication.report.pdf import write_pdf
@@ -163,7 +163,8 @@ def findings(argv: list[str]) -> None:
     record, out = resolve(settings["record"]), resolve(settings["findings"])
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
-    drawn, rendered_from = Drawn(resolve(settings["reports"]) / PAGES), inputs(record, out / "templates")
+    drawn = Drawn(resolve(settings["reports"]) / PAGES)
+    rendered_from = inputs(record, out / "templates", resolve(settings["published_values"]))
     status = drawn.folder / STATUS
     drawn_from = json.loads(status.read_text()).get("drawn_from") if status.exists() else None
     if drawn_from != {k: v for k, v in rendered_from.items() if k != "templates"}:  # another record, or code

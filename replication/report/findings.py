@@ -17,8 +17,9 @@ every number it quotes taken from the record's drawn pages (``<reports>/record``
   experiments' cost, as Markdown tables.
 
 A row a template names that the record does not hold stops the rendering with one line naming it.
-:data:`RENDERED` records what the pages were rendered from (the record, the templates, the code) so that a
-check costs no drawing: :func:`stale` says why pages no longer match (``tests/test_findings.py``).
+:data:`RENDERED` records what the pages were rendered from (the record, the templates, the configs, the
+published values, the code) so that a check costs no drawing: :func:`stale` says why pages no longer match
+(``tests/test_findings.py``).
 """
 
 import hashlib
@@ -32,6 +33,7 @@ import jinja2
 import pandas as pd
 
 from replication.evidence.claims import Paper, load_papers
+from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, sha256
 from replication.report.pages.recorded import STATUS
 from replication.runner.provenance import run_code_digest
@@ -214,15 +216,21 @@ def render(drawn: Drawn, templates: Path) -> dict[str, str]:
     return pages
 
 
-def inputs(record: Path, templates: Path) -> dict[str, str]:
+def inputs(record: Path, templates: Path, published: Path) -> dict[str, str]:
     """What the pages are rendered from, each as a digest: the record (its manifest's SHA-256, which holds
-    every file's), the templates, and the code that draws the record's pages and renders them (every module
-    the report's command imports)."""
-    text = hashlib.sha256()
-    for path in sorted(Path(templates).glob("*.md.j2")):
-        text.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    return {"record": sha256(Path(record) / MANIFEST), "templates": text.hexdigest(),
+    every file's), the templates, the configs (the claims' words, the experiments' methods and tables), the
+    papers' published values, and the code that draws the record's pages and renders them (every module the
+    report's command imports)."""
+    return {"record": sha256(Path(record) / MANIFEST), "templates": _files(Path(templates), "*.md.j2"),
+            "configs": _files(CONF_DIR, "*.yaml"), "published": sha256(published) if Path(published).exists() else "",
             "code": run_code_digest(("report/__main__.py",))}
+
+
+def _files(folder: Path, pattern: str) -> str:
+    digest = hashlib.sha256()
+    for path in sorted(folder.rglob(pattern)):
+        digest.update(path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
 
 
 def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str]) -> list[Path]:
