@@ -11,7 +11,8 @@ import pytest
 from replication.paths import PACKAGE_DIR
 from replication.record.manifest import MANIFEST, PAGES, sha256
 from replication.report.__main__ import findings, main as report
-from replication.report.findings import Drawn, estimate, inputs, number, render, stale, write_html, write_pages
+from replication.report.findings import (Drawn, drawn_inputs, estimate, inputs, number, render, stale, write_html,
+                                         write_pages)
 
 ROOT = PACKAGE_DIR.parent
 FINDINGS = ROOT / "docs" / "findings"
@@ -131,8 +132,7 @@ def test_findings_writes_the_pages_and_draws_the_record_only_when_needed(tmp_pat
     (record / MANIFEST).write_text("{}")
     shutil.copytree(pages, reports / PAGES)
     (out / "templates").mkdir(parents=True)
-    drawn_from = {k: v for k, v in inputs(record, out / "templates", tmp_path / "none.csv").items()
-                  if k != "templates"}
+    drawn_from = drawn_inputs(inputs(record, out / "templates", tmp_path / "none.csv"))
     status = json.loads((reports / PAGES / "status.json").read_text())
     (reports / PAGES / "status.json").write_text(json.dumps({**status, "drawn_from": drawn_from}))
     (out / "templates" / "p.md.j2").write_text('{{ claim("p.a").verdict }}\n')

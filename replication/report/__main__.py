@@ -27,7 +27,7 @@ from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest
 from replication.record.runs import Record
-from replication.report.findings import Drawn, inputs, write_html, write_pages
+from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
 from replication.report.pages.experiment import write_experiment_report
 from replication.report.pages.index import write_index
@@ -88,8 +88,7 @@ def main(argv: list[str]) -> None:
     reports = resolve(cfg.reports)
     if source == "record":
         held = resolve(cfg.record)
-        drawn_from = {k: v for k, v in inputs(held, resolve(cfg.findings) / "templates",
-                                              resolve(cfg.published_values)).items() if k != "templates"}
+        drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", resolve(cfg.published_values)))
         print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
     if switches["pdf"]:
         from replication.report.pdf import write_pdf
@@ -154,12 +153,10 @@ def findings(argv: list[str]) -> None:
     pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code."""
     import json
 
-    from omegaconf import OmegaConf
-
     if {"--help", "-h"} & set(argv):
         print(findings.__doc__)
         return
-    settings = {**OmegaConf.load(CONF_DIR / "config.yaml"), **dict(a.partition("=")[::2] for a in argv)}
+    settings = _settings(argv)
     record, out = resolve(settings["record"]), resolve(settings["findings"])
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
@@ -167,7 +164,7 @@ def findings(argv: list[str]) -> None:
     rendered_from = inputs(record, out / "templates", resolve(settings["published_values"]))
     status = drawn.folder / STATUS
     drawn_from = json.loads(status.read_text()).get("drawn_from") if status.exists() else None
-    if drawn_from != {k: v for k, v in rendered_from.items() if k != "templates"}:  # another record, or code
+    if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
         main(["source=record", "pdf=false", *argv])
     try:
         pages = render_findings(drawn, out / "templates")
@@ -180,9 +177,7 @@ def findings(argv: list[str]) -> None:
 def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -> tuple[list[str], list[str]]:
     """The experiments to draw from the record (those it holds, of ``names``) and the overrides that draw
     them: the paper scale, into ``<reports>/record``."""
-    from omegaconf import OmegaConf
-
-    settings = {**OmegaConf.load(CONF_DIR / "config.yaml"), **dict(o.partition("=")[::2] for o in overrides)}
+    settings = _settings(overrides)
     held = Manifest.read(resolve(settings["record"])).experiments
     if not held:
         fail(f"{resolve(settings['record'])}: no record here (make record writes one from a paper-scale store)")
@@ -191,6 +186,13 @@ def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -
     reports = Path(settings["reports"]) / PAGES
     kept = [o for o in overrides if o.partition("=")[0] not in ("scale", "reports")]
     return [name for name in names if name in held], [*kept, "scale=paper", f"reports={reports}"]
+
+
+def _settings(overrides: list[str]) -> dict:
+    """The top-level settings of ``conf/config.yaml`` with ``key=value`` overrides, without Hydra."""
+    from omegaconf import OmegaConf
+
+    return {**OmegaConf.load(CONF_DIR / "config.yaml"), **dict(o.partition("=")[::2] for o in overrides)}
 
 
 def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]) -> None:

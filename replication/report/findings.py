@@ -226,6 +226,11 @@ def inputs(record: Path, templates: Path, published: Path) -> dict[str, str]:
             "code": run_code_digest(("report/__main__.py",))}
 
 
+def drawn_inputs(rendered_from: dict[str, str]) -> dict[str, str]:
+    """Of the pages' inputs, those the record's drawn pages depend on (all but the templates)."""
+    return {k: v for k, v in rendered_from.items() if k != "templates"}
+
+
 def _files(folder: Path, pattern: str) -> str:
     digest = hashlib.sha256()
     for path in sorted(folder.rglob(pattern)):
