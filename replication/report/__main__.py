@@ -16,6 +16,7 @@ cell, and ``reports/replication.pdf`` gathers the same tables and figures
 view of the index as ``reports/screenshot.png`` (where Chromium is installed).
 """
 
+import shutil
 import sys
 from pathlib import Path
 
@@ -40,6 +41,8 @@ from replication.runner.results import Results
 from replication.runner.store import Store
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
+SCREENSHOT = "screenshot.png"
+PICTURE = "scorecard.png"  # the record's first page beside its findings (the README shows it)
 OPTIONS = ("sweep", "metric", "source")  # ours too: name=text
 SOURCES = ("store", "record")
 
@@ -111,7 +114,7 @@ def main(argv: list[str]) -> None:
             print("screenshot: skipped, no Chromium on the PATH (apt-get install chromium)",
                   file=sys.stderr)
         else:
-            seen = open_in_browser(index, reports / "screenshot.png")
+            seen = open_in_browser(index, reports / SCREENSHOT)
             print(f"screenshot: {seen['screenshot']}")
             for line in seen["console"]:
                 print(f"console: {line}", file=sys.stderr)
@@ -150,7 +153,8 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
 def findings(argv: list[str]) -> None:
     """``pf-replicate findings [record=record] [reports=reports] [findings=docs/findings]``: each paper's
     findings rendered from the record into ``<findings>/<paper>.md`` (:mod:`replication.report.findings`), its
-    pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code."""
+    pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code;
+    when drawn, their first page's picture too (``<findings>/scorecard.png``, where Chromium is installed)."""
     import json
 
     if {"--help", "-h"} & set(argv):
@@ -165,7 +169,11 @@ def findings(argv: list[str]) -> None:
     status = drawn.folder / STATUS
     drawn_from = json.loads(status.read_text()).get("drawn_from") if status.exists() else None
     if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
-        main(["source=record", "pdf=false", *argv])
+        (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
+        main(["source=record", "pdf=false", "screenshot=true", *argv])
+        if (drawn.folder / SCREENSHOT).exists():  # the scorecard's picture, where Chromium is installed
+            shutil.copyfile(drawn.folder / SCREENSHOT, out / PICTURE)
+            print(f"findings: {out / PICTURE}")
     try:
         pages = render_findings(drawn, out / "templates")
     except LookupError as error:
