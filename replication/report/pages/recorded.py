@@ -21,8 +21,8 @@ STATUS = "status.json"
 def write_status(out: Path, manifest: Manifest, stale: dict[str, int], drawn_from: dict[str, str]) -> Path:
     """``<out>/status.json``: the manifest's account of the runs drawn, per experiment how many of its
     recorded runs other code or settings than this checkout's made (``stale``), and what the pages were
-    drawn from (``drawn_from``: the manifest's SHA-256 and the drawing code's digest, so that pages of
-    another record or code are drawn again before findings are rendered from them)."""
+    drawn from (``drawn_from``: the digests of the record, the configs, the published values and the
+    drawing code, so that pages drawn from other inputs are drawn again before findings are rendered)."""
     entries = {name: manifest.experiments[name] for name in stale}
     status = {
         "drawn_from": drawn_from,
