@@ -9,7 +9,7 @@ from conftest import typed
 
 from replication.evidence.aggregate import summarise
 from replication.evidence.quantities import quantity
-from replication.evidence.statistics import estimate, mean, median, paired_difference, proportion
+from replication.evidence.statistics import estimate, mean, median, paired_difference, proportion, stratified_mean
 from replication.errors import ConfigError
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict, judge_band, judge_value, stability_bands
 from replication.evidence.published import load_published
@@ -42,6 +42,16 @@ def test_mean_is_the_t_interval_and_stays_in_range():
     assert near_top.high == 1.0 and 0.0 <= near_top.low
     assert np.isnan(mean([2.0, 2.0, 2.0]).low)  # every run equal: no zero-width interval
     assert np.isnan(mean([5.0]).low) and np.isnan(mean([]).value)
+
+
+def test_a_stratified_mean_of_runs_all_equal_has_no_interval_though_their_variance_rounds_above_zero():
+    groups = [np.full(5, 0.4123204837490552), np.full(5, 0.10880952380952381)]  # a deterministic tracker's runs
+    assert groups[0].var(ddof=1) > 0  # rounding: the mean of five copies is not the copy
+    shown = stratified_mean(groups, 0.0, 1.0)
+    assert np.isnan(shown.low) and np.isnan(shown.high) and shown.method == "stratified t (every run equal)"
+    assert shown.value == pytest.approx((0.4123204837490552 + 0.10880952380952381) / 2)
+    varied = stratified_mean([np.array([0.1, 0.2, 0.3]), np.array([0.5, 0.5, 0.5])])
+    assert varied.low < varied.value < varied.high
 
 
 def test_t_interval_covers_the_true_mean_about_95_percent_of_the_time_at_5_runs():

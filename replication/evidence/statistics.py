@@ -102,9 +102,9 @@ def stratified_mean(groups, low: float = -math.inf, high: float = math.inf, min_
     runs = sum(len(values) for values in groups)
     if min(len(values) for values in groups) < max(min_runs, 2):
         return Estimate(centre, math.nan, math.nan, runs, "stratified t")
-    parts = np.array([values.var(ddof=1) / len(values) for values in groups]) / len(groups) ** 2
-    if parts.sum() == 0:
+    if all(np.all(values == values[0]) for values in groups):  # as in mean: not var == 0, which rounding misses
         return Estimate(centre, math.nan, math.nan, runs, "stratified t (every run equal)")
+    parts = np.array([values.var(ddof=1) / len(values) for values in groups]) / len(groups) ** 2
     df = parts.sum() ** 2 / np.sum(parts ** 2 / np.array([len(values) - 1 for values in groups]))
     half = float(stats.t.ppf((1 + INFERENCE.level) / 2, df) * np.sqrt(parts.sum()))
     return Estimate(centre, max(centre - half, low), min(centre + half, high), runs, "stratified t")
