@@ -155,8 +155,6 @@ def findings(argv: list[str]) -> None:
     findings rendered from the record into ``<findings>/<paper>.md`` (:mod:`replication.report.findings`), its
     pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code;
     when drawn, their first page's picture too (``<findings>/scorecard.png``, where Chromium is installed)."""
-    import json
-
     if {"--help", "-h"} & set(argv):
         print(findings.__doc__)
         return
@@ -166,8 +164,7 @@ def findings(argv: list[str]) -> None:
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
     drawn = Drawn(resolve(settings["reports"]) / PAGES)
     rendered_from = inputs(record, out / "templates", resolve(settings["published_values"]))
-    status = drawn.folder / STATUS
-    drawn_from = json.loads(status.read_text()).get("drawn_from") if status.exists() else None
+    drawn_from = drawn.status.get("drawn_from") if (drawn.folder / STATUS).exists() else None
     if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
         main(["source=record", "pdf=false", "screenshot=true", *argv])

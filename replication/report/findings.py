@@ -33,6 +33,7 @@ import jinja2
 import pandas as pd
 
 from replication.evidence.claims import Paper, load_papers
+from replication.evidence.summary import load_summaries
 from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, sha256
 from replication.report.pages.recorded import STATUS
@@ -132,8 +133,7 @@ class Drawn:
 
     def experiments_of(self, paper: str) -> list[str]:
         """The paper's experiments the record holds, by their summaries."""
-        return [p.parent.name for p in sorted(self.folder.glob("*/summary.json"))
-                if json.loads(p.read_text())["paper"] == paper]
+        return [name for name, summary in load_summaries(self.folder).items() if summary.paper == paper]
 
 
 def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
