@@ -52,7 +52,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from markupsafe import Markup  # noqa: E402
 
-from replication.filters import PointMassFilter, bootstrap  # noqa: E402
+from replication import PointMassFilter, bootstrap  # noqa: E402
 from replication.models import UNGM  # noqa: E402
 from replication.paths import resolve  # noqa: E402
 from replication.report.pages.index import write_index  # noqa: E402

@@ -61,7 +61,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from replication.filters import PointMassFilter, bootstrap  # noqa: E402
+from replication import PointMassFilter, bootstrap  # noqa: E402
 from replication.models import UNGM  # noqa: E402
 from replication.paths import resolve  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402

@@ -7,10 +7,11 @@ top-level name, ``from replication import bootstrap, kalman_filter, VideoSequenc
   propose -> move -> weight -> estimate -> resample loop, which takes any
   :class:`StateSpaceModel` (``sample_initial``, ``propagate``, ``log_likelihood``);
   its :class:`ResamplingPolicy` and the resampling schemes; ESS and weight helpers;
-* the filters (:mod:`replication.filters`): every builder of the :data:`FILTERS`
-  registry (:func:`bootstrap` and the five papers' variants), :func:`build_filter`
-  to make one from config keys, and :func:`tracker` to step one or many targets
-  through frames;
+* the filters (:mod:`replication.filters`): :func:`bootstrap` and the five papers'
+  variants, every registered builder by name (:func:`builders`, the entry points of
+  ``replication.filters``, a user's own included), :func:`builder` for one name or
+  import path, :func:`build_filter` to make one from config keys, and :func:`tracker`
+  to step one or many targets through frames;
 * models (:mod:`replication.models`): :class:`LinearGaussian` with its exact
   :func:`kalman_filter`, :class:`UNGM`, :class:`AdditiveGaussianModel` to derive
   your own scalar model from, :class:`BoxModel` for a target's box in video;
@@ -35,7 +36,7 @@ _EXPORTS = {  # module: the public names it defines, in the order of the API ref
     ),
     "replication.smc.resampling": ("RESAMPLERS", "multinomial", "residual", "stratified", "systematic"),
     "replication.smc.weights": ("ess", "normalise", "weighted_mean", "weighted_variance"),
-    "replication.filters": ("FILTERS", "build_filter"),
+    "replication.filters.registry": ("build_filter", "builder", "builders"),
     "replication.filters.bootstrap": ("bootstrap",),
     "replication.filters.point_mass": ("PointMassFilter",),
     "replication.filters.pso": ("pso",),

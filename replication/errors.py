@@ -12,6 +12,10 @@ def fail(message: str) -> None:
     raise SystemExit(2)
 
 
-class NotFinite(ValueError):
-    """A number a run needs is NaN or infinite (log-weights, say): the run fails with this reason, which
-    is stored (:mod:`replication.runner.failures`), rather than stopping the command."""
+class RunFailed(ValueError):
+    """A run that cannot give a record: it fails with this reason, which is stored
+    (:mod:`replication.runner.failures`), rather than stopping the command."""
+
+
+class NotFinite(RunFailed):
+    """A number a run needs is NaN or infinite (log-weights, say)."""

@@ -8,7 +8,7 @@ import pytest
 from conftest import PROJECT_ROOT
 
 import replication
-from replication.filters import FILTERS
+from replication.filters.registry import builders
 
 
 def test_import_replication_loads_no_numerical_library():
@@ -29,7 +29,7 @@ def test_every_public_name_resolves_to_its_module(name):
 
 
 def test_every_registered_filter_is_a_public_name():
-    for builder in FILTERS.values():
+    for builder in builders().values():
         assert getattr(replication, builder.__name__) is builder
 
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from replication.filters import bootstrap
+from replication import bootstrap
 from replication.models import UNGM, LinearGaussian, kalman_filter
 from replication.smc import ParticleFilter, ResamplingPolicy
 

@@ -42,14 +42,14 @@ def test_a_run_is_keyed_by_the_code_it_runs(tmp_path):
     runs of that filter (and of the filters built on it) and no other."""
     import shutil
 
-    from replication.filters import FILTERS
+    from replication.filters.registry import builders
     from replication.runner.provenance import run_code_digest, source_of
     from replication.tasks import TASKS
 
     digest = run_code_digest.__wrapped__  # uncached: the same folder is hashed after each edit
     package = tmp_path / "replication"
     shutil.copytree(PACKAGE_DIR, package, ignore=shutil.ignore_patterns("__pycache__", "conf"))
-    pairs = {(task, name): (source_of(TASKS[task]), source_of(FILTERS[name])) for task in TASKS for name in FILTERS}
+    pairs = {(task, name): (source_of(TASKS[task]), source_of(made)) for task in TASKS for name, made in builders().items()}
 
     def keys() -> dict:
         return {pair: digest(entries, package) for pair, entries in pairs.items()}

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from replication.filters import PointMassFilter
+from replication import PointMassFilter
 from replication.models import UNGM, LinearGaussian, kalman_filter, point_mass_filter
 
 
@@ -57,7 +57,7 @@ def test_point_mass_filter_is_converged_on_ungm():
 
 def test_point_mass_mean_is_the_best_estimator_on_average():
     """Across trajectories the grid posterior mean has lower MSE than a large particle filter's."""
-    from replication.filters import bootstrap
+    from replication import bootstrap
 
     model = UNGM(steps=50)
     grid_se, pf_se = [], []

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from replication.filters import FILTERS
+from replication.filters.registry import builder
 from replication.filters.ism import ISMMove
 from replication.filters.pso import PSOMove
 from replication.models import LinearGaussian
@@ -189,7 +189,7 @@ def test_pso_stops_once_the_global_best_is_good_enough():
 def test_moves_plug_into_the_one_loop(name, extra):
     model = LinearGaussian(steps=15)
     observations = model.simulate(np.random.default_rng(0))[1]
-    output = FILTERS[name](n_particles=50, **extra).run(_Column(model), observations, np.random.default_rng(1))
+    output = builder(name)(n_particles=50, **extra).run(_Column(model), observations, np.random.default_rng(1))
     assert np.all(np.isfinite(output.means)) and output.resample_count == 15
 
 

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 from scipy.stats import multivariate_normal
 
-from replication.filters import FILTERS
+from replication.filters.registry import builder
 from replication.filters.open_tracker import ParticleTracker
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.models.boosted import BoostedBoxModel
@@ -134,7 +134,7 @@ def test_a_target_is_born_from_persistent_detections_and_dies_after_its_absence(
         return BoostedBoxModel(box, ColourLikelihood.from_frame(image, box, histogram, 0.1), cache=cache,
                                step_sd=(2.0, 2.0, 0.5, 0.5), alpha=0.5)
 
-    tracker = ParticleTracker(FILTERS[method](**params), new_model, Initiator(frames=3), Deleter(frames=3, min_rho=0.7))
+    tracker = ParticleTracker(builder(method)(**params), new_model, Initiator(frames=3), Deleter(frames=3, min_rho=0.7))
     out = {frame: ids.tolist() for frame, ids, _ in tracker.track(_Square(), range(1, 17), np.random.default_rng(0))}
     assert all(out[f] == [] for f in (1, 2, 3, 4))  # detected from frame 3: born on its third, frame 5
     assert all(out[f] == [1] for f in range(5, 11))
@@ -161,7 +161,7 @@ def test_output_detected_shows_a_track_only_in_the_frames_a_detection_is_associa
                                step_sd=(2.0, 2.0, 0.5, 0.5), alpha=0.5)
 
     for output, shown in (("supported", True), ("detected", False)):
-        tracker = ParticleTracker(FILTERS["mipf"](n_particles=200), new_model, Initiator(frames=2),
+        tracker = ParticleTracker(builder("mipf")(n_particles=200), new_model, Initiator(frames=2),
                                   Deleter(frames=3, min_rho=0.7), output=output)
         out = {frame: ids.tolist() for frame, ids, _ in tracker.track(Gappy(), range(1, 12), np.random.default_rng(0))}
         assert out[7] == out[9] == [1] and (out[8] == [1]) is shown

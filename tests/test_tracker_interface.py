@@ -5,7 +5,7 @@ import zlib
 
 import numpy as np
 
-from replication.filters import BISPF, bootstrap
+from replication import BISPF, bootstrap
 from replication.filters.joint import JointFilter
 from replication.filters.tracker import Adaptation, Independent, Joint, Marginal, tracker
 from replication.smc.loop import ParticleFilter

@@ -3,7 +3,7 @@
 import numpy as np
 from conftest import SMALL
 
-from replication.filters import bootstrap
+from replication import bootstrap
 from replication.metrics.tracking import centre_error
 from replication.models.box import BoxModel
 from replication.runner.config import expand

@@ -22,9 +22,9 @@ from omegaconf import DictConfig, OmegaConf
 
 from replication.condition import Condition
 from replication.errors import ConfigError
-from replication.filters import FILTERS, build_filter
+from replication.filters.registry import build_filter, builder
 from replication.run import Run
-from replication.runner.provenance import run_code_digest, source_of
+from replication.runner.provenance import method_code_digest
 from replication.scales import SCALES, at_scale
 from replication.runner.sequences import locate_sequences
 from replication.tasks import TASKS, DataMissing
@@ -57,7 +57,7 @@ def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
     """Hash of everything that can change a run's numbers (not its repetition): the config and the code the
     run executes (its task's and its filter's modules and what they import)."""
     numeric = {k: v for k, v in method.items() if k != "label"}
-    code = run_code_digest((source_of(TASKS[task]), source_of(FILTERS[method["filter"]])))
+    code = method_code_digest(TASKS[task], builder(method["filter"]))
     blob = json.dumps({"task": task, "model": model, "method": numeric, "seed": base_seed, "code": code},
                       sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
@@ -100,9 +100,9 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
         raise ConfigError("experiment.methods is empty")
     runs, skipped = [], [] if skipped is None else skipped
     for method, params in methods.items():
-        if params.get("filter") not in FILTERS:
-            what = f"unknown filter {params['filter']!r}" if "filter" in params else "no 'filter:' key"
-            raise ConfigError(f"method {method!r}: {what}; known filters: {', '.join(sorted(FILTERS))}")
+        if "filter" not in params:
+            raise ConfigError(f"method {method!r}: no 'filter:' key (a registered name or module:name)")
+        builder(params["filter"])
         sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
         only = params.pop("only", None) or {}  # e.g. {scene: [exp1_3123]}: a method run on some conditions only
         observation = params.pop("observation", None) or {}  # e.g. fusion_pf's colour-only filter: {alpha: 1}

@@ -31,7 +31,7 @@ from joblib import Parallel, delayed, effective_n_jobs, parallel_config
 from tqdm.auto import tqdm
 
 import replication
-from replication.errors import NotFinite
+from replication.errors import RunFailed
 from replication.run import Run
 from replication.runner.failures import failure
 from replication.runner.lifeline import watch_parent
@@ -56,14 +56,15 @@ class BackendError(RuntimeError):
 
 def perform(run: Run) -> dict:
     """One run: a pure function of the run's identity, parameters and seed.  Its record, or, when a
-    number it needs or gives is not finite, only its run id and the reason (``failure``, :mod:`.failures`)."""
+    number it needs or gives is not finite or its method returns the wrong thing, only its run id and the
+    reason (``failure``, :mod:`.failures`)."""
     retain_freed_memory()  # in whichever process computes it: a worker of any backend
     one_blas_thread()
     started = time.perf_counter()
     try:
         metrics = TASKS[run.task].run(run)
         reason = failure(metrics)
-    except NotFinite as error:
+    except RunFailed as error:
         reason = str(error)
     if reason:
         return {"run_id": run.run_id, "failure": reason}

@@ -3,7 +3,8 @@
 A task's record is checked in the process that computed it (:func:`failure`): every number in it,
 per-frame series included, must be finite, except the metrics of :data:`UNDEFINED`, which are NaN
 (or infinite) by definition for some runs.  A run stopped by a number it needs that is not finite
-(:class:`replication.errors.NotFinite`: NaN log-weights, say) fails the same way.  A failed run leaves
+(:class:`replication.errors.NotFinite`: NaN log-weights, say), or by a method that returns the wrong thing
+(:class:`replication.errors.RunFailed`), fails the same way.  A failed run leaves
 ``<run id>.failed`` in the store (:meth:`replication.runner.store.Store.write_failure`) holding the
 reason: it is not computed again, the report leaves it out of every statistic and counts it, and the
 run command names each reason with its count and exits with status :data:`FAILED_STATUS`.  The same

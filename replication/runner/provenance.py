@@ -17,6 +17,7 @@ import ast
 import datetime
 import hashlib
 import importlib.metadata
+import importlib.util
 import inspect
 import platform
 import subprocess
@@ -66,6 +67,36 @@ def run_code_digest(entries: tuple[str, ...], package: Path = PACKAGE) -> str:
     return digest.hexdigest()[:12]
 
 
+def method_code_digest(task, builder) -> str:
+    """The code a run of ``builder`` (a method's filter) under ``task`` executes, as 12 hex digits: for a
+    built-in, :func:`run_code_digest` of the two; for a user's builder from outside the package (a plugin),
+    also the bytes of its own source files (its module and the modules of its own top-level package that it
+    imports, transitively, each by its path inside that package) and its distribution's name and version
+    where one is installed, so an edit of the plugin gives its runs new keys and leaves the others'."""
+    source = Path(inspect.getsourcefile(builder)).resolve()
+    if source.is_relative_to(PACKAGE):
+        return run_code_digest((source_of(task), source.relative_to(PACKAGE).as_posix()))
+    top = builder.__module__.split(".")[0]
+    single = builder.__module__ == top and source.name != "__init__.py"  # a module of its own, not a package
+    base = source.parent if single else _package_base(top)
+    files, entries, todo = set(), {source_of(task)}, [source] if single else [source, base / "__init__.py"]
+    while todo:
+        path = todo.pop()
+        if path in files:
+            continue
+        files.add(path)
+        within = "" if single else ".".join((top, *path.relative_to(base).with_suffix("").parts)[:-1])
+        names = _imported_names(ast.parse(path.read_text(), str(path)), within)
+        entries |= _module_files({n for n in names if n.split(".")[0] == PACKAGE.name}, PACKAGE)
+        todo.extend(base / relative for relative in _module_files({n for n in names if n.split(".")[0] == top}, base))
+    digest = hashlib.sha256(run_code_digest(tuple(sorted(entries))).encode())
+    for path in sorted(files):
+        digest.update(path.relative_to(base).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    for distribution in sorted(importlib.metadata.packages_distributions().get(top, [])):
+        digest.update(f"{distribution}=={importlib.metadata.version(distribution)}".encode() + b"\0")
+    return digest.hexdigest()[:12]
+
+
 def source_of(code) -> str:
     """The path inside the package of the file that defines ``code`` (a module, class or function): an entry
     of :func:`run_code_digest`."""
@@ -76,28 +107,45 @@ def source_of(code) -> str:
 def _imports(relative: str, package: Path) -> frozenset[str]:
     """The package's source files that importing ``relative`` runs: the modules it imports (anywhere in it,
     functions included) and the ``__init__.py`` of every package on their way."""
-    tree = ast.parse((package / relative).read_text(), relative)
+    modules = _imported_names(ast.parse((package / relative).read_text(), relative))
+    parts = Path(relative).with_suffix("").parts
+    modules.update(".".join((package.name, *parts[:i])) for i in range(len(parts)))  # its own packages
+    return frozenset(_module_files({m for m in modules if m.split(".")[0] == package.name}, package) | {"__init__.py"})
+
+
+def _imported_names(tree: ast.AST, within: str = "") -> set[str]:
+    """Every module name a source imports, and ``module.name`` for each name imported from a module (a
+    submodule, if it is one); a relative import is resolved against ``within``, the source's own package."""
     modules = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             modules.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module:
-            modules.add(node.module)
-            modules.update(f"{node.module}.{alias.name}" for alias in node.names)  # a submodule, if it is one
-    parts = Path(relative).with_suffix("").parts
-    modules.update(".".join((package.name, *parts[:i])) for i in range(len(parts)))  # its own packages
+        elif isinstance(node, ast.ImportFrom) and (node.module or node.level):
+            up = within.split(".")[: len(within.split(".")) - node.level + 1] if node.level else []
+            module = ".".join([*up, *([node.module] if node.module else [])])
+            modules.add(module)
+            modules.update(f"{module}.{alias.name}" for alias in node.names)
+    return modules
+
+
+def _module_files(modules: set[str], package: Path) -> set[str]:
+    """The files inside ``package`` (its folder, named as its top-level module) that importing each of
+    ``modules`` runs: the module's own and the ``__init__.py`` of every package on its way."""
     files = set()
     for module in modules:
         names = module.split(".")
-        if names[0] != package.name:
-            continue
         for i in range(2, len(names) + 1):  # every package on the way runs its __init__.py
             path = Path(*names[1:i])
             for candidate in (path.with_suffix(".py"), path / "__init__.py"):
                 if (package / candidate).is_file():
                     files.add(candidate.as_posix())
-    files.add("__init__.py")
-    return frozenset(files)
+    return files
+
+
+def _package_base(top: str) -> Path:
+    """The folder of a user's top-level package ``top`` (its files are named inside it)."""
+    spec = importlib.util.find_spec(top)
+    return Path(next(iter(spec.submodule_search_locations))).resolve()
 
 
 @lru_cache(maxsize=1)

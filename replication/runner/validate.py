@@ -46,15 +46,15 @@ def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
 def check_method_parameters(cfg: DictConfig) -> None:
     """Each method parameter against the type its filter declares (``n_particles: int``),
     so that ``n_particles=abc`` names the key instead of failing inside ``int()``."""
-    from replication.filters import FILTERS
+    from replication.filters.registry import builder
 
     if not isinstance(cfg.experiment.get("methods"), DictConfig):
         return  # expand says what is wrong
     methods = at_scale(OmegaConf.to_container(cfg.experiment.methods, resolve=True), cfg.scale)
     for method, params in methods.items():
-        if not isinstance(params, dict) or params.get("filter") not in FILTERS:
-            continue
-        declared = _declared_types(FILTERS[params["filter"]])
+        if not isinstance(params, dict) or "filter" not in params:
+            continue  # expand says what is wrong
+        declared = _declared_types(builder(params["filter"]))
         values = [
             (f"experiment.methods.{method}.{k}", k, v) for k, v in params.items() if k not in RESERVED_METHOD_KEYS
         ]

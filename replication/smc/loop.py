@@ -18,6 +18,7 @@ from typing import Protocol
 
 import numpy as np
 
+from replication.errors import RunFailed
 from replication.smc.resampling import RESAMPLERS
 from replication.smc.weights import (
     DegenerateWeightsError,
@@ -104,6 +105,17 @@ class FilterOutput:
     @property
     def resample_count(self) -> int:
         return int(self.resampled.sum())
+
+
+def expect_output(output, shape: tuple[int, ...], method: str) -> FilterOutput:
+    """``output`` if it is a :class:`FilterOutput` whose means have ``shape`` (one estimate per step), else
+    the run fails (:class:`~replication.errors.RunFailed`) saying what ``method`` returned instead."""
+    if not isinstance(output, FilterOutput):
+        raise RunFailed(f"method {method!r}: run returned a {type(output).__name__}, not a FilterOutput")
+    if np.shape(output.means) != shape:
+        raise RunFailed(f"method {method!r}: run returned means of shape {np.shape(output.means)}, not {shape} "
+                        "(one estimate per step)")
+    return output
 
 
 @dataclass

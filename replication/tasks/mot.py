@@ -24,7 +24,7 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
-from replication.filters import build_filter
+from replication.filters.registry import build_filter
 from replication.filters.joint import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
 from replication.filters.track_management import Deleter, Initiator

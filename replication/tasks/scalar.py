@@ -2,10 +2,11 @@
 
 import time
 
-from replication.filters import build_filter
+from replication.filters.registry import build_filter
 from replication.metrics import filter_diagnostics, rmse
 from replication.models import MODELS
 from replication.run import Run
+from replication.smc.loop import expect_output
 from replication.smc.work import Counted, Work
 
 
@@ -33,6 +34,7 @@ def run(run: Run) -> dict:
     started = time.perf_counter()
     output = method.run(Counted(model, work), observations, run.rng("filter"))
     elapsed = time.perf_counter() - started
+    output = expect_output(output, states.shape, run.method)  # a user's method may return anything
     return {
         "rmse": rmse(output.means, states),
         "ms_per_step": 1000.0 * elapsed / model.steps,

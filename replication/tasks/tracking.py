@@ -17,7 +17,7 @@ averages (mean CLE, shares of correct frames) are over the frames it filtered.
 import numpy as np
 import pandas as pd
 
-from replication.filters import build_filter
+from replication.filters.registry import build_filter
 from replication.filters.tracker import Adaptation, Marginal
 from replication.filters.tracker import tracker as make_tracker
 from replication.metrics import multi
