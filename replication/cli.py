@@ -90,6 +90,15 @@ def chosen_experiments(argv: list[str]) -> list[str]:
     return names
 
 
+def own_claims(argv: list[str]) -> list[str]:
+    """``claims_dir=<folder>/claims`` where a ``--config-dir`` folder holds a ``claims/`` folder and the request
+    names no ``claims_dir=`` itself: a user's experiments and their claims sit side by side."""
+    if any(arg.startswith("claims_dir=") for arg in argv):
+        return []
+    found = [folder / "claims" for folder in config_dirs(argv) if (folder / "claims").is_dir()]
+    return [f"claims_dir={found[0].resolve()}"] if found else []
+
+
 def check_request(argv: list[str]) -> None:
     """Compose the config as Hydra will and check it (:mod:`replication.runner.preflight`), so that
     a bad override (an unknown key written without ``+``, a malformed or out-of-range value) is one
@@ -156,7 +165,8 @@ def run_experiment(cfg: DictConfig) -> None:
         fail(str(error))
     if reported_as != cfg.experiment.name:
         print(f"{cfg.experiment.name}: this request changes the shipped experiment (your data or settings): "
-              f"reported as {reported_as}, judging no paper claim")
+              f"reported as {reported_as}, judging no paper claim"
+              + (f" (your own claims in {cfg.claims_dir})" if cfg.get("claims_dir") else ""))
     for message in skipped:
         print(f"skipped: {message}", file=sys.stderr)
     store = Store(resolve(cfg.store), cfg.experiment.name)
@@ -247,6 +257,7 @@ def run(argv: list[str]) -> None:
     if "--version" in argv:
         print(f"pf-replicate {__version__}")
         return
+    argv = [*argv, *own_claims(argv)]
     try:
         check_request(argv)
     except ConfigError as error:

@@ -6,7 +6,7 @@ import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
-from conftest import typed
+from conftest import PROJECT_ROOT, typed
 
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
@@ -181,6 +181,34 @@ def test_a_quoted_size_is_tested_against_ours():
     ratio = {**spec, "size": {"table": "t1", "kind": "ratio"}}
     verdict = Result.of(ClaimTest.of(ratio, experiment, published).checks(records, {})).verdict
     assert "ratio 0.381" in verdict.why
+
+
+def test_a_users_claim_quotes_its_own_numbers_for_the_size():
+    """No published table: the reading quotes the pair, and the size is tested as a paper's is."""
+    records = _records({"A": 0.0, "B": 0.2})
+    spec = {"test": "order", "metric": "rmse", "order": ["A", "B"], "size": {"quoted": {"A": 1.6, "B": 4.2}}}
+    verdict = _verdict(spec, records)  # no published values at all
+    assert verdict.outcome is Outcome.NOT_REPRODUCED and "the sign agrees, the size does not" in verdict.why
+    agreeing = {**spec, "size": {"quoted": {"A": 4.8, "B": 5.0}}}  # a gap of 0.2, ours
+    assert _verdict(agreeing, records).outcome is Outcome.REPRODUCED
+
+
+def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_line(tmp_path):
+    from replication.errors import ConfigError
+    from replication.evidence.claims import load_own_papers
+
+    own = load_own_papers(PROJECT_ROOT / "examples" / "auxiliary_pf" / "conf" / "claims")
+    assert [paper.key for paper in own] == ["apf"] and [c.id for c in own[0].claims] == ["apf.ungm"]
+    with pytest.raises(ConfigError, match="no claims file"):
+        load_own_papers(tmp_path)
+    head = "paper: mine\norder: 7\ntitle: t\nauthors: a\nvenue: v\nclaims:\n  - id: mine.x\n    claim: c\n"
+    (tmp_path / "mine.yaml").write_text(head + "    readings: []\n")
+    with pytest.raises(ConfigError, match=r"mine.yaml lacks the key 'source'; see conf/claims/\*.yaml$"):
+        load_own_papers(tmp_path)
+    (tmp_path / "mine.yaml").write_text(head + "    source: s\n    readings:\n"
+                                        "      - {name: r, experiment: e, test: faster}\n")
+    with pytest.raises(ConfigError, match=r"mine.yaml: unknown claim test 'faster'; known: .*order"):
+        load_own_papers(tmp_path)
 
 
 def test_threshold():

@@ -33,6 +33,7 @@ from replication.evidence.inference import Test, mean_test, proportion_test, sai
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
+from replication.errors import ConfigError
 from replication.paths import CONF_DIR
 from replication.qmc import discrepancy_table
 from replication.evidence.published import cells as published_cells
@@ -209,7 +210,8 @@ class Order(ClaimTest):
     Each pair is a check on the runs that filtered the same data and where both methods' metric is defined
     (:func:`~replication.evidence.comparisons.order_test`): Student's paired
     t-test (McNemar's exact test for yes/no outcomes) in the claimed direction,
-    and, where ``size:`` names the paper's table, the paper's own gap between
+    and, where ``size:`` names the paper's table (or a user's claim quotes its
+    numbers, ``size: {quoted: {A: 4.1, B: 4.5}}``), the paper's own gap between
     the two (a difference, or with ``kind: ratio`` a ratio) against ours.
     ``tolerance`` (a fraction of the beaten method's mean) turns "better" into
     "no worse than by more than that" (a claim of equal cost, say).
@@ -244,6 +246,10 @@ class Order(ClaimTest):
         """The paper's numbers for the pair at our ``condition``, matched with its cells as our table named by
         ``size.table`` matches them (None where ``size`` names none, or a number is missing)."""
         size = self.spec.get("size")
+        if size and "quoted" in size:  # a user's claim quoting its own numbers ({method: number}), no table
+            quoted = size["quoted"]
+            return Effect(float(quoted[better]), float(quoted[worse]), size.get("kind", "difference")) \
+                if better in quoted and worse in quoted else None
         if not size or self.published is None:
             return None
         table = next(t for t in self.experiment["report"]["tables"] if t["name"] == size["table"])
@@ -497,27 +503,54 @@ class Uniformity(ClaimTest):
 def load_papers(directory: Path = CLAIMS_DIR) -> tuple[Paper, ...]:
     """Every paper's claims, in the order the papers are numbered (``order:`` in each file); read once
     per process (every experiment's report asks for them)."""
-    papers = []
-    for path in sorted(Path(directory).glob("*.yaml")):
-        data = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-        claims = tuple(
-            Claim(id=c["id"], paper=data["paper"], text=c["claim"], source=c["source"], cells=c.get("cells") or {},
-                  readings=tuple(Reading(r["name"], r["experiment"], {k: v for k, v in r.items()
-                                                                      if k not in ("name", "experiment")})
-                                 for r in c["readings"]),
-                  note=c.get("note", ""))
-            for c in data["claims"]
-        )
-        papers.append((data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)))
+    papers = [_paper(path) for path in sorted(Path(directory).glob("*.yaml"))]
     return tuple(paper for _, paper in sorted(papers, key=lambda item: item[0]))
 
 
+def load_own_papers(directory: Path) -> tuple[Paper, ...]:
+    """A user's claims files (the ``claims_dir`` setting) in the papers' format, judged on the user's own
+    reports only; a folder without one, a file lacking a key or a reading naming an unknown test is one
+    :class:`~replication.errors.ConfigError` line naming the file."""
+    paths = sorted(Path(directory).glob("*.yaml"))
+    if not paths:
+        raise ConfigError(f"claims_dir={directory}: no claims file (*.yaml) there")
+    papers = []
+    for path in paths:
+        try:
+            order, paper = _paper(path)
+        except (KeyError, TypeError, AttributeError, yaml.YAMLError) as error:
+            what = f"lacks the key {error}" if isinstance(error, KeyError) else f"is not in the claims format ({error})"
+            raise ConfigError(f"{path} {what}; see conf/claims/*.yaml") from None
+        unknown = [r.test.get("test") for c in paper.claims for r in c.readings
+                   if r.test.get("test") not in ClaimTest.registry]
+        if unknown:
+            raise ConfigError(f"{path}: unknown claim test {unknown[0]!r}; known: {', '.join(sorted(ClaimTest.registry))}")
+        papers.append((order, paper))
+    return tuple(paper for _, paper in sorted(papers, key=lambda item: item[0]))
+
+
+def _paper(path: Path) -> tuple[int, Paper]:
+    """One claims file: its paper's ``order`` and the paper with its claims."""
+    data = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    claims = tuple(
+        Claim(id=c["id"], paper=data["paper"], text=c["claim"], source=c["source"], cells=c.get("cells") or {},
+              readings=tuple(Reading(r["name"], r["experiment"], {k: v for k, v in r.items()
+                                                                  if k not in ("name", "experiment")})
+                             for r in c["readings"]),
+              note=c.get("note", ""))
+        for c in data["claims"]
+    )
+    return data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)
+
+
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table],
-             published: pd.DataFrame | None = None) -> dict[str, dict[str, "Result"]]:
+             published: pd.DataFrame | None = None,
+             papers: tuple[Paper, ...] | None = None) -> dict[str, dict[str, "Result"]]:
     """The results of every reading that names experiment ``name``: {claim id: {reading name: result}}
-    (``published``: the paper's numbers, whose sizes the ``order`` tests compare with ours)."""
+    (``published``: the paper's numbers, whose sizes the ``order`` tests compare with ours; ``papers``:
+    whose claims, the five papers' unless a user's own are given)."""
     results = {}
-    for paper in load_papers():
+    for paper in load_papers() if papers is None else papers:
         for claim in paper.claims:
             for reading in claim.readings:
                 if reading.experiment != name:

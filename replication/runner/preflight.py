@@ -62,6 +62,9 @@ def check_settings(cfg: DictConfig) -> None:
         raise ConfigError(f"scale must be one of {', '.join(SCALES)}, got {cfg.get('scale')!r}")
     if not isinstance(cfg.get("outside_project"), bool):
         raise ConfigError(f"outside_project must be true or false, got {cfg.get('outside_project')!r}")
+    claims = cfg.get("claims_dir")
+    if claims is not None and (not isinstance(claims, str) or not resolve(claims).is_dir()):
+        raise ConfigError(f"claims_dir must be a folder of your claims files (*.yaml), got {claims!r}")
     for key in ("store", "reports"):
         value = cfg.get(key)
         if not isinstance(value, str) or not value:

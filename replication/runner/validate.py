@@ -13,6 +13,7 @@ import typing
 from omegaconf import DictConfig, OmegaConf
 
 from replication.errors import ConfigError
+from replication.filters.registry import builder
 from replication.paths import resolve
 from replication.run import Run
 from replication.runner.config import expand
@@ -46,8 +47,6 @@ def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
 def check_method_parameters(cfg: DictConfig) -> None:
     """Each method parameter against the type its filter declares (``n_particles: int``),
     so that ``n_particles=abc`` names the key instead of failing inside ``int()``."""
-    from replication.filters.registry import builder
-
     if not isinstance(cfg.experiment.get("methods"), DictConfig):
         return  # expand says what is wrong
     methods = at_scale(OmegaConf.to_container(cfg.experiment.methods, resolve=True), cfg.scale)
@@ -134,6 +133,10 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
     """
     settings = parallel_settings(cfg)
     check_method_parameters(cfg)
+    if cfg.get("claims_dir"):  # a user's own claims: read now, so a broken file stops nothing half-run
+        from replication.evidence.claims import load_own_papers
+
+        load_own_papers(resolve(str(cfg.claims_dir)))
     check_scenes(cfg)
     skipped: list[str] = []
     runs = expand(cfg, skipped)

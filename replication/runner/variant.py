@@ -19,7 +19,7 @@ from omegaconf import DictConfig
 from omegaconf.errors import OmegaConfBaseException
 
 from replication.errors import ConfigError
-from replication.paths import CONF_DIR
+from replication.paths import CONF_DIR, experiment_names
 from replication.runner.config import experiment_at_scale
 from replication.runner.sequences import DEFAULT_ROOTS, SHIPPED_ROOTS
 
@@ -31,9 +31,11 @@ def differences(cfg: DictConfig) -> list[str]:
     """What the request changes in the shipped experiment, one line per key added, removed or changed (a
     whole scene or method once), in key order; empty for the experiment as shipped.  An experiment the
     package does not ship is the user's throughout."""
+    if cfg.experiment.name not in experiment_names():  # a --config-dir's (Hydra would compose it from there)
+        return [f"experiment {cfg.experiment.name}: not one the package ships"]
     try:
         shipped = experiment_at_scale(_shipped(cfg.experiment.name, cfg.scale))
-    except (HydraException, OmegaConfBaseException):  # not an experiment of the package (a --config-dir's)
+    except (HydraException, OmegaConfBaseException):  # renamed inside its file: not the package's
         return [f"experiment {cfg.experiment.name}: not one the package ships"]
     ours = experiment_at_scale(cfg)
     kinds = {spec.get("kind") for spec in (ours.get("scenes") or {}).values()}

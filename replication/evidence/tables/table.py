@@ -170,7 +170,7 @@ class TableKind:
 
     def theirs(self) -> pd.DataFrame:
         spec = self.spec
-        return cells(self.published, self.experiment["paper"], spec["paper_table"],
+        return cells(self.published, self.experiment["paper"], spec.get("paper_table"),  # none: a user's own table
                      spec.get("paper_metric", spec.get("metric")))
 
     def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, rating: str = ""

@@ -12,7 +12,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
-from replication.evidence.claims import Result, evaluate
+from replication.evidence.claims import Result, evaluate, load_own_papers
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
 from replication.export import LAYOUTS, write_results
@@ -66,8 +66,10 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     sequences = write_sequence_pages(records, experiment, out) if len(records) else []
     compared = tuple(cell for table in built.values() for cell in table.cells)
     matched = {cell.published_index for cell in compared}
-    # a user's own data or settings judge no paper claim: the claims name the papers' data
-    claims = {} if results.own else evaluate(experiment["name"], experiment, records, built, published)
+    # a user's own data, methods or settings judge no paper claim (the claims name the papers' data and
+    # methods), only the user's own claims (claims_dir), by the same rules
+    own = load_own_papers(resolve(cfg.claims_dir)) if results.own and cfg.get("claims_dir") else ()
+    claims = evaluate(experiment["name"], experiment, records, built, published, own if results.own else None)
     changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
