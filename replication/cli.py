@@ -164,8 +164,9 @@ def run_experiment(cfg: DictConfig) -> None:
     except ConfigError as error:
         fail(str(error))
     if reported_as != cfg.experiment.name:
-        print(f"{cfg.experiment.name}: this request changes the shipped experiment (your data or settings): "
-              f"reported as {reported_as}, judging no paper claim"
+        what = ("this request changes the shipped experiment (your data or settings)"
+                if cfg.experiment.name in experiment_names() else "your own experiment")
+        print(f"{cfg.experiment.name}: {what}: reported as {reported_as}, judging no paper claim"
               + (f" (your own claims in {cfg.claims_dir})" if cfg.get("claims_dir") else ""))
     for message in skipped:
         print(f"skipped: {message}", file=sys.stderr)
