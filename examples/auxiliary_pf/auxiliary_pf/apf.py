@@ -18,20 +18,25 @@ model have it), and ``draw``, one draw from ``propagate``, which needs nothing b
 model interface.  A draw makes the second-stage weights heavy-tailed where the likelihood is narrow
 against the prior's spread: on a linear-Gaussian model observing x_t directly, E[1 / p(z_t | mu)] is
 infinite once the state noise variance Q reaches the observation noise variance R, and the error
-then falls more slowly than N^(-1/2) (``check_apf.py`` shows it).
+then falls more slowly than N^(-1/2).
 
-The second-stage weights are carried into the next step's first stage (W_t), so each step resamples
-exactly once, in its first stage; this is the weighted form of the APF analysed by Johansen and Doucet
-("A note on auxiliary particle filters", Statistics & Probability Letters 78, 2008), where Pitt and
-Shephard resample the second-stage draws once more to an equally weighted set.
+Steps 1-4 are a proposal of the loop (:class:`~replication.smc.loop.Proposal`, :func:`first_stage`), which returns the
+log-weights log(sum_i W_{t-1}^i p(z_t | mu_t^i)) - log N - log p(z_t | mu_t^{k_j}); the loop adds
+log p(z_t | x_t^j) (step 5), normalises, and adds their log-sum to the log-evidence, which is then the
+APF's estimate of p(z_t | z_{1:t-1}); a step no particle explains falls back as in every filter of
+the loop.  The second-stage weights are carried into the next step's first stage (W_t), so each step
+resamples exactly once, in its first stage; this is the weighted form of the APF analysed by Johansen
+and Doucet ("A note on auxiliary particle filters", Statistics & Probability Letters 78, 2008), where
+Pitt and Shephard resample the second-stage draws once more to an equally weighted set.
 """
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
-from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy, Weighed, prior_proposal
+from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy, Weighed
 from replication.smc.resampling import RESAMPLERS
 from replication.smc.weights import DegenerateWeightsError, normalise
 
@@ -49,71 +54,38 @@ def drawn_look_ahead(model, parents: np.ndarray, t: int, rng: np.random.Generato
 LOOK_AHEADS = {"mean": mean_look_ahead, "draw": drawn_look_ahead}
 
 
+def first_stage(model, particles, log_weights, t, rng, *, z, look_ahead: Callable, scheme: str):
+    """Steps 1-4 for observation ``z`` (z_t), as a proposal of the loop: parents chosen by the likelihood
+    of their look-ahead points (resampled with ``scheme``), then moved by the prior."""
+    looked = model.log_likelihood(look_ahead(model, particles, t, rng), z, t)  # log p(z_t | mu_t^i)
+    try:
+        first, log_first = normalise(log_weights + looked)
+    except DegenerateWeightsError:  # no look-ahead point explains z_t: parents by W_{t-1} alone
+        looked = np.zeros(len(particles))
+        first, log_first = normalise(log_weights)
+    ancestors = RESAMPLERS[scheme](first, rng)  # never a parent of zero lambda
+    moved = model.propagate(particles[ancestors], t, rng)
+    return moved, log_first - np.log(len(particles)) - looked[ancestors]
+
+
 @dataclass
 class AuxiliaryParticleFilter(ParticleFilter):
-    """The APF on :class:`~replication.smc.loop.ParticleFilter`: ``weigh`` is the two-stage step of
-    the module docstring, ``conclude`` records it without a second resampling.  ``resampling.scheme``
-    is the first stage's scheme; the first stage resamples at every step (``ess_threshold`` 1).
-
-    ``run`` (the scalar task) and ``start`` / ``step`` (the video task) are the base class's.
-    """
+    """The APF on :class:`~replication.smc.loop.ParticleFilter`: its proposal is the first stage
+    (resampled with ``resampling.scheme``), the loop's weighting the second, and the loop resamples no
+    more (``ess_threshold`` 0); ``run`` (the scalar task) and ``start`` / ``step`` (the video task) are
+    the base class's."""
 
     look_ahead: Callable = mean_look_ahead
 
-    def __post_init__(self):
-        super().__post_init__()
-        if self.proposal is not prior_proposal or self.move is not None:
-            raise ValueError("the auxiliary particle filter moves particles by the model's prior only: "
-                             "it takes no proposal or move")
-        if self.resampling.ess_threshold < 1.0:
-            raise ValueError("the auxiliary particle filter resamples in its first stage at every step "
-                             f"(ess_threshold 1), got ess_threshold={self.resampling.ess_threshold}")
-
     def weigh(self, state: FilterState, z) -> Weighed:
-        """Steps 1-5 of the module docstring for z_t; the state only advances its t.
-
-        As the base loop does (:meth:`ParticleFilter.weigh`), a stage whose log-weights are all -inf is
-        recovered by its weights before the likelihood: a first stage where no look-ahead point explains
-        z_t selects parents by W_{t-1} alone (a bootstrap step); a second stage where no moved particle
-        does keeps the weights 1 / p(z_t | mu_t^{k_j}), under which the resampled set stands for the
-        prediction p(x_t | z_{1:t-1}), as if z_t had carried no information.  Either is flagged in
-        ``FilterOutput.degenerate``.
-
-        ``log_evidence`` gains log sum_i W_{t-1}^i p(z_t | mu_t^i) + log (1/N) sum_j w_j, with w_j the
-        second-stage weights: the APF's estimate of p(z_t | z_{1:t-1}).
-        """
-        model, rng, n = state.model, state.rng, self.n_particles
-        state.t += 1
-        t = state.t
-        parents = state.particles
-        look_ahead = model.log_likelihood(self.look_ahead(model, parents, t, rng), z, t)  # log p(z_t | mu_t^i)
-        try:
-            first, log_first = normalise(state.log_weights + look_ahead)
-            first_degenerate = False
-        except DegenerateWeightsError:
-            look_ahead = np.zeros(n)
-            first, log_first = normalise(state.log_weights)
-            first_degenerate = True
-        ancestors = RESAMPLERS[self.resampling.scheme](first, rng)  # never a parent of zero lambda
-        particles = model.propagate(parents[ancestors], t, rng)
-        predicted = -look_ahead[ancestors]  # finite: a selected parent has lambda > 0
-        log_weights = predicted + model.log_likelihood(particles, z, t)
-        try:
-            weights, log_total = normalise(log_weights)
-            degenerate = False
-        except DegenerateWeightsError:
-            log_weights = predicted
-            weights, log_total = normalise(predicted)
-            degenerate = True
-        state.log_evidence += log_first + log_total - np.log(n)
-        return Weighed(particles, weights, log_weights, log_total, degenerate or first_degenerate)
+        """One step of the loop with the first stage for this z_t as its proposal."""
+        self.proposal = partial(first_stage, z=z, look_ahead=self.look_ahead, scheme=self.resampling.scheme)
+        return super().weigh(state, z)
 
     def conclude(self, state: FilterState, weighed: Weighed) -> None:
-        """Record the estimate of the second-stage weighted particles and keep their weights for the
-        next first stage; ``resampled`` is True at every step (the first stage resampled)."""
-        state.records.add(weighed.particles, weighed.weights, weighed.degenerate)
-        state.records.resampled.append(True)
-        state.particles, state.log_weights = weighed.particles, weighed.log_weights
+        """The loop's record of the step, which resampled in its first stage."""
+        super().conclude(state, weighed)
+        state.records.resampled[-1] = True
 
 
 def auxiliary_pf(n_particles: int, look_ahead: str = "mean", resampling: str = "systematic") -> AuxiliaryParticleFilter:
@@ -122,5 +94,5 @@ def auxiliary_pf(n_particles: int, look_ahead: str = "mean", resampling: str = "
     systematic or residual)."""
     if look_ahead not in LOOK_AHEADS:
         raise ValueError(f"look_ahead must be one of {sorted(LOOK_AHEADS)}, got {look_ahead!r}")
-    return AuxiliaryParticleFilter(n_particles=n_particles, resampling=ResamplingPolicy(resampling, 1.0),
+    return AuxiliaryParticleFilter(n_particles=n_particles, resampling=ResamplingPolicy(resampling, 0.0),
                                    look_ahead=LOOK_AHEADS[look_ahead])
