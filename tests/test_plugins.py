@@ -96,14 +96,26 @@ def test_two_distributions_registering_one_name_is_one_line(example, installed):
      "experiment.methods.Mine.n_particles must be an integer, got 'many'"),
     ("{filter: my_pf, n_particles: 50}", "unknown filter 'my_pf'; known filters: bis, bootstrap, "),
 ])
-def test_a_bad_plugin_is_one_line_before_any_run(cli, tmp_path, method, said):
+def test_a_bad_plugin_is_one_line_before_any_run(make_cfg, tmp_path, monkeypatch, example, method, said):
+    """Each is the run command's check before any work (``prepare``: its message is the one line it prints)."""
+    from replication.runner.validate import prepare
+
     (tmp_path / "plugins").mkdir()
     (tmp_path / "plugins" / "broken.py").write_text('raise RuntimeError("needs a GPU")\n')
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join((str(tmp_path / "plugins"), str(EXAMPLE)))}
-    done = cli("experiment=hspf_ungm", "scale=quick", f"+experiment.methods.Mine={method}", env=env)
-    assert done.returncode == 2, done.stderr
-    assert done.stderr.startswith(f"error: {said}") and done.stderr.count("\n") == 1, done.stderr
+    monkeypatch.syspath_prepend(str(tmp_path / "plugins"))
+    with pytest.raises(ConfigError) as error:
+        prepare(make_cfg("hspf_ungm", "scale=quick", f"+experiment.methods.Mine={method}"))
+    assert str(error.value).startswith(said) and "\n" not in str(error.value)
     assert not (tmp_path / "experiments").exists()  # nothing ran
+
+
+def test_a_plugin_that_does_not_import_is_one_line_on_the_command_line(cli, tmp_path):
+    env = {**os.environ, "PYTHONPATH": str(EXAMPLE)}
+    done = cli("experiment=hspf_ungm", "scale=quick", "+experiment.methods.Mine={filter: nosuch:MyPF}", env=env)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == ("error: filter 'nosuch:MyPF': module nosuch does not import (ModuleNotFoundError: No "
+                           "module named 'nosuch')\n")
+    assert not (tmp_path / "experiments").exists()
 
 
 def test_a_method_returning_the_wrong_shape_fails_its_runs_and_keeps_the_others(cli, tmp_path):
