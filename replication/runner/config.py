@@ -53,11 +53,10 @@ def _set(params: dict[str, Any], name: str, value: Any) -> None:
     params[key] = value
 
 
-def _run_key(task: str, model: dict, method: dict, base_seed: int) -> str:
-    """Hash of everything that can change a run's numbers (not its repetition): the config and the code the
-    run executes (its task's and its filter's modules and what they import)."""
+def _run_key(task: str, model: dict, method: dict, base_seed: int, code: str) -> str:
+    """Hash of everything that can change a run's numbers (not its repetition): the config and ``code``, the
+    digest of the code the run executes (:func:`~replication.runner.provenance.method_code_digest`)."""
     numeric = {k: v for k, v in method.items() if k != "label"}
-    code = method_code_digest(TASKS[task], builder(method["filter"]))
     blob = json.dumps({"task": task, "model": model, "method": numeric, "seed": base_seed, "code": code},
                       sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
@@ -99,6 +98,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     if not methods:
         raise ConfigError("experiment.methods is empty")
     runs, skipped = [], [] if skipped is None else skipped
+    codes: dict[str, str] = {}  # filter name -> the digest of the code its runs execute
     for method, params in methods.items():
         if "filter" not in params:
             raise ConfigError(f"method {method!r}: no 'filter:' key (a registered name or module:name)")
@@ -132,7 +132,9 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
                 where = f" ({condition})" if condition else ""
                 raise ConfigError(f"model{where}: {error}") from None
             build_filter(method, run_params, str(condition))
-            key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed))
+            if run_params["filter"] not in codes:  # a filter's code is digested once, not once per swept value
+                codes[run_params["filter"]] = method_code_digest(task, builder(run_params["filter"]))
+            key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed), codes[run_params["filter"]])
             runs.extend(
                 Run(exp.name, exp.task, method, condition, r, run_model, run_params, int(cfg.base_seed), key,
                     data_condition)
