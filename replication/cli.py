@@ -214,13 +214,19 @@ def run_multiverse(cfg: DictConfig) -> None:
     for message in multiverse.skipped:
         print(f"skipped: {message}", file=sys.stderr)
     name = cfg.experiment.name
-    print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices")
+    distinct = sum(len(multiverse.runs_of(experiment)) for experiment in multiverse.experiments)
+    print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices, "
+          f"{distinct} distinct runs")
     store, runs = None, None
     try:
-        for experiment in multiverse.experiments:
-            store, runs = Store(resolve(cfg.store), experiment), multiverse.runs_of(experiment)
-            done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
-            print(f"{name}: {experiment}: {done} runs computed, {len(runs) - done} already stored")
+        # universe by universe, the default first: a multiverse stopped part-way (a session's end, a Ctrl-C)
+        # leaves whole universes, which the record takes one by one (replication.record.write)
+        for number, universe in enumerate(multiverse.universes, 1):
+            for experiment in multiverse.experiments:
+                store, runs = Store(resolve(cfg.store), experiment), multiverse.runs[universe.name, experiment]
+                done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
+                print(f"{name}: universe {number}/{len(multiverse.universes)} ({universe.name}): {experiment}: "
+                      f"{done} runs computed, {len(runs) - done} already stored", flush=True)
         from hydra.core.hydra_config import HydraConfig
 
         from replication.report.pages.index import write_index
