@@ -37,7 +37,7 @@ from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project
 from replication.runner.lifeline import (
     child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
 )
-from replication.runner.preflight import check_yaml, preflight
+from replication.runner.preflight import check_yaml, preflight, written_experiment
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
 MULTIRUN_FLAGS = ("--multirun", "-m")
@@ -132,7 +132,7 @@ def check_request(argv: list[str]) -> None:
                     f"unknown key {key!r} (check the spelling; a key the config lacks is added as +{key}=...)"
                 ) from None
             raise ConfigError(" ".join(lines) or error.__class__.__name__) from None
-        preflight(cfg)
+        preflight(cfg, written_experiment(experiment_file(name, argv)))
 
 
 def interrupted(store=None, runs=None) -> None:

@@ -57,6 +57,8 @@ def assert_one_line(result, tmp_path, named):
         (("experiment=demo_scene", "experiment.model.motion.step_sd=[4,nan,0.5,0.5]"), "motion.step_sd"),
         (("experiment=demo_scene", "experiment.model.motion.step_sd=[4,-4,0.5,0.5]"), "must not be negative"),
         (("experiment=hspf_ungm", "experiment.runs.quick=2.5"), "experiment.runs.quick"),
+        # measured against the file's 100, not against the overridden count itself
+        (("experiment=hspf_ungm", "experiment.runs.paper=5000"), "= 5,000 runs per condition, against the paper's 100"),
         (("experiment=hspf_ungm", "experiment.name=../../../x"), "experiment.name"),
         (("experiment=hspf_ungm", "experiment.name=a/b"), "experiment.name"),
         (("experiment=hspf_ungm", "experiment.methods=[1,2]"), "experiment.methods=[1,2]"),
@@ -237,11 +239,11 @@ def test_a_misspelt_sequence_of_ones_own_fails_in_one_line(tmp_path, args, named
 def test_every_shipped_experiment_passes_the_preflight(make_cfg, scale):
     """The checks refuse nothing the project ships (their rules are about values, not about our configs)."""
     from replication.paths import experiment_names
-    from replication.runner.preflight import check_yaml, preflight
+    from replication.runner.preflight import preflight, written_experiment
 
     for name in experiment_names():
-        check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
-        preflight(make_cfg(name, f"scale={scale}", "outside_project=true"))
+        written = written_experiment(summary.CONF_DIR / "experiment" / f"{name}.yaml")
+        preflight(make_cfg(name, f"scale={scale}", "outside_project=true"), written)
 
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out

@@ -245,3 +245,21 @@ def test_a_choice_that_leaves_the_runs_as_they_are_has_no_effect_exactly():
     assert (effect.value, effect.low, effect.high, p) == (0.0, 0.0, 0.0, 1.0) and effect.method == "the same runs"
     effect, p = paired_effect({0: 1.0}, {0: 2.0})  # one shared run: nothing to pair
     assert effect is None and np.isnan(p)
+
+
+@pytest.mark.e2e  # a subprocess: make test-fast leaves it out
+def test_the_command_runs_a_multiverse_universe_by_universe(cli, tmp_path):
+    """Every experiment's runs of one universe are stored before the next universe starts, the default
+    first: a multiverse stopped part-way (a session's end) leaves whole universes, which the record takes
+    one by one (``replication.record.write.write_multiverse``)."""
+    result = cli("experiment=hspf_readings", "scale=quick", "progress=false")
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stdout.splitlines() if ": universe " in line]
+    done = [line.split(": universe ")[1].split(":")[:2] for line in lines]  # [["k/n (name)", " experiment"], ...]
+    universes = [u for u, _ in done]
+    assert universes[0].startswith("1/") and "(default)" in universes[0]
+    assert universes == sorted(universes, key=lambda u: int(u.split("/")[0]))  # never back to an earlier universe
+    n = int(universes[0].split("/")[1].split()[0])
+    experiments = ["hspf_ungm", "hspf_ungm_cost"]  # hspf_readings.yaml's experiments at the quick scale
+    assert [e.strip() for _, e in done] == experiments * n  # each universe: every experiment, in turn
+    assert f"{n} universes of" in result.stdout and "distinct runs" in result.stdout

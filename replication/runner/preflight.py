@@ -49,6 +49,12 @@ def check_yaml(path: Path) -> None:
         raise ConfigError(f"{path} {what}")
 
 
+def written_experiment(path: Path) -> dict:
+    """An experiment file as written (checked by :func:`check_yaml`), before Hydra applies any override."""
+    check_yaml(path)
+    return yaml.safe_load(path.read_text())
+
+
 def check_settings(cfg: DictConfig) -> None:
     """The top-level settings: seed, workers, scale, and the output folders (inside the project,
     writable)."""
@@ -92,8 +98,9 @@ def check_writable(key: str, folder: Path) -> None:
         raise ConfigError(f"{key}: cannot write in {existing} ({error.strerror})") from None
 
 
-def check_experiment(cfg: DictConfig) -> None:
-    """The experiment's structure, names and numbers (a multiverse is checked by its own loader)."""
+def check_experiment(cfg: DictConfig, written_paper: Any = None) -> None:
+    """The experiment's structure, names and numbers (a multiverse is checked by its own loader);
+    ``written_paper``: the paper-scale run count its file gives, before any override."""
     experiment = cfg.get("experiment")
     if not isinstance(experiment, DictConfig):
         raise ConfigError("name an experiment: experiment=<name>")
@@ -120,14 +127,17 @@ def check_experiment(cfg: DictConfig) -> None:
     values = OmegaConf.to_container(experiment, resolve=True)
     for block in ("runs", "model", "methods", "scenes"):
         check_numbers(values.get(block), f"experiment.{block}", block)
-    check_size(values["runs"], cfg.get("scale"), bool(cfg.get("force")))
+    check_size(values["runs"], cfg.get("scale"), bool(cfg.get("force")), written_paper)
 
 
-def check_size(runs: dict, scale: str, force: bool) -> None:
+def check_size(runs: dict, scale: str, force: bool, written_paper: Any = None) -> None:
     """A run count far beyond the paper's (more than :data:`BEYOND` times it, or :data:`MOST_RUNS` runs per
     condition: a typo of a few zeros) is refused unless ``force=true``: its runs would be expanded and queued
-    before the first is computed."""
-    wanted, paper = runs.get(scale), runs.get("paper")
+    before the first is computed.  The paper's count is the experiment file's (``written_paper``), so that
+    an override of ``runs.paper`` itself is measured against it; the count as composed where the file gives
+    none."""
+    wanted = runs.get(scale)
+    paper = written_paper if _integer(written_paper) else runs.get("paper")
     if force or not _integer(wanted) or not _integer(paper):
         return
     if wanted > BEYOND * paper or wanted > MOST_RUNS:
@@ -162,9 +172,11 @@ def check_numbers(value: Any, where: str, key: str = "") -> None:
         raise ConfigError(f"{where} must be a positive integer, got {value!r}")
 
 
-def preflight(cfg: DictConfig) -> None:
-    """Every check of this module, in the order a user would fix them."""
-    check_experiment(cfg)
+def preflight(cfg: DictConfig, written: dict | None = None) -> None:
+    """Every check of this module, in the order a user would fix them; ``written``: the experiment's file
+    as written (:func:`written_experiment`), whose run counts overrides are measured against."""
+    runs = (written or {}).get("runs")
+    check_experiment(cfg, runs.get("paper") if isinstance(runs, dict) else None)
     check_settings(cfg)
 
 
