@@ -218,27 +218,49 @@ def run_multiverse(cfg: DictConfig) -> None:
     print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices, "
           f"{distinct} distinct runs")
     store, runs = None, None
+    recorded = recorded_universes(cfg, multiverse)
     try:
         # universe by universe, the default first: a multiverse stopped part-way (a session's end, a Ctrl-C)
         # leaves whole universes, which the record takes one by one (replication.record.write)
         for number, universe in enumerate(multiverse.universes, 1):
+            where = f"{name}: universe {number}/{len(multiverse.universes)} ({universe.name})"
+            if universe.name in recorded:
+                print(f"{where}: in the record as this code computes it (skip_recorded=false runs it)", flush=True)
+                continue
             for experiment in multiverse.experiments:
                 store, runs = Store(resolve(cfg.store), experiment), multiverse.runs[universe.name, experiment]
                 done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
-                print(f"{name}: universe {number}/{len(multiverse.universes)} ({universe.name}): {experiment}: "
-                      f"{done} runs computed, {len(runs) - done} already stored", flush=True)
+                print(f"{where}: {experiment}: {done} runs computed, {len(runs) - done} already stored", flush=True)
         from hydra.core.hydra_config import HydraConfig
 
         from replication.report.pages.index import write_index
         from replication.report.pages.multiverse import write_multiverse_report
 
-        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task))
+        def store_of(experiment, universe):  # a universe skipped as recorded is read from the record
+            return recorded[universe.name] if universe.name in recorded else Store(resolve(cfg.store), experiment)
+
+        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task), store_of)
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
     except (BackendError, StoreFull) as error:
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
+
+
+def recorded_universes(cfg: DictConfig, multiverse) -> dict:
+    """The universes of ``multiverse`` that the paper-scale record holds as this code computes them (every run
+    recorded under the key it has now), each as the record's view of it; none unless ``skip_recorded`` and the
+    paper scale.  A multiverse too long for one sitting then goes on, on any machine, where the record
+    stops."""
+    if not (cfg.get("skip_recorded") and cfg.scale == "paper"):
+        return {}
+    from replication.record.runs import Record
+
+    record = Record(resolve(cfg.record))
+    views = {u.name: record.universe(multiverse.name, u.name) for u in multiverse.universes}
+    return {u.name: views[u.name] for u in multiverse.universes
+            if all(views[u.name].holds(multiverse.runs[u.name, e]) for e in multiverse.experiments)}
 
 
 def run_companions(cfg: DictConfig) -> None:

@@ -63,6 +63,7 @@ def assert_one_line(result, tmp_path, named):
         (("experiment=hspf_ungm", "experiment.name=a/b"), "experiment.name"),
         (("experiment=hspf_ungm", "experiment.methods=[1,2]"), "experiment.methods=[1,2]"),
         (("experiment=hspf_ungm", "outside_project=maybe"), "outside_project"),
+        (("experiment=hspf_ungm", "skip_recorded=1"), "skip_recorded must be true or false"),
     ],
 )
 def test_config_errors_are_one_line_before_any_heavy_import(tmp_path, args, named):

@@ -303,3 +303,12 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     Store(tmp_path / "store", "hspf_ungm").path(next(r for r in larger_runs if r.method == "HSPF")).unlink()
     partial = write([cfg], tmp_path / "store", tmp_path / "partial").experiments["hspf_test_readings"]
     assert list(partial.files) == ["hspf_test_readings/universes/default.parquet"]
+    # the command goes on where a record stops: a universe recorded under this code's keys is not run again
+    from replication.cli import recorded_universes
+
+    assert not record.universe(multiverse.name, larger.name).holds(multiverse.runs["default", "hspf_ungm"])
+    for folder, scale, skip, expected in (("partial", "paper", True, ["default"]), ("record", "paper", True,
+                                          ["default", larger.name]), ("record", "paper", False, []),
+                                          ("record", "quick", True, [])):
+        cfg.record, cfg.scale, cfg.skip_recorded = str(tmp_path / folder), scale, skip
+        assert sorted(recorded_universes(cfg, multiverse)) == expected, (folder, scale, skip)

@@ -136,6 +136,12 @@ class Record:
         return {path.stem: pq.read_table(path).to_pandas()
                 for path in sorted((self.root / experiment / CURVES_DIR).glob("*.parquet"))}
 
+    def holds(self, runs: list[Run]) -> bool:
+        """Whether every one of ``runs`` is recorded, and as this code and these settings compute it (its
+        recorded key is the run's): reading it here gives what running it would."""
+        found = self.found(runs)
+        return len(found) == len(runs) and all(row["run_key"] == run.key for run, row in found)
+
     def stale(self, runs: list[Run]) -> list[Run]:
         """The recorded runs among ``runs`` that other code or settings made (their recorded key is not
         the run's): the record shows what that code computed, not what this code would."""
