@@ -4,7 +4,8 @@
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
 #                  (where one run's time goes: python benchmarks/profile_run.py EXPERIMENT METHOD [TEXT] [--scale paper])
-# make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE
+# make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE (at paper: what the record
+#                  lacks, universe by universe, then recorded)
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
 # make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does)
@@ -72,8 +73,11 @@ replicate: setup
 	$(BIN)/python -m replication.report.pages.calibration
 	$(BIN)/python -m replication.report.pdf
 
+# At SCALE=paper the universes the record holds as this code computes them are read from it, not run
+# again, and every universe run whole is recorded: stopped part-way, the next call goes on from there.
 readings: setup
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(READINGS)) scale=$(SCALE) n_jobs=$(JOBS)
+	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record experiment=$(subst $(space),$(comma),$(READINGS)) && $(BIN)/python -m replication findings)
 	$(BIN)/python -m replication.report.pdf
 
 record: setup

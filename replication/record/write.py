@@ -88,7 +88,8 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
             found, absent = stored_rows(multiverse.runs[universe.name, name], Store(store_root, name), series)
             rows, missing = rows + [{**picks, **r} for r in found], missing + absent
         if missing:
-            print(f"skipped: {multiverse.name}, universe {universe.name}: {missing} runs not in the store",
+            kept_as = "kept as recorded" if path.exists() else "not recorded"
+            print(f"skipped: {multiverse.name}, universe {universe.name}: {missing} runs not in the store ({kept_as})",
                   file=sys.stderr)
         else:
             write_table(runs_table(rows), path)
