@@ -249,18 +249,15 @@ def run_multiverse(cfg: DictConfig) -> None:
 
 
 def recorded_universes(cfg: DictConfig, multiverse) -> dict:
-    """The universes of ``multiverse`` that the paper-scale record holds as this code computes them (every run
-    recorded under the key it has now), each as the record's view of it; none unless ``skip_recorded`` and the
-    paper scale.  A multiverse too long for one sitting then goes on, on any machine, where the record
-    stops."""
+    """The universes of ``multiverse`` that the paper-scale record holds as this code computes them, each as
+    the record's view of it (:meth:`~replication.record.runs.Record.universes_held`); none unless
+    ``skip_recorded`` and the paper scale.  A multiverse too long for one sitting then goes on, on any
+    machine, where the record stops."""
     if not (cfg.get("skip_recorded") and cfg.scale == "paper"):
         return {}
     from replication.record.runs import Record
 
-    record = Record(resolve(cfg.record))
-    views = {u.name: record.universe(multiverse.name, u.name) for u in multiverse.universes}
-    return {u.name: views[u.name] for u in multiverse.universes
-            if all(views[u.name].holds(multiverse.runs[u.name, e]) for e in multiverse.experiments)}
+    return Record(resolve(cfg.record)).universes_held(multiverse)
 
 
 def run_companions(cfg: DictConfig) -> None:

@@ -142,6 +142,13 @@ class Record:
         found = self.found(runs)
         return len(found) == len(runs) and all(row["run_key"] == run.key for run, row in found)
 
+    def universes_held(self, multiverse) -> dict[str, "Record"]:
+        """The universes of ``multiverse`` (a :class:`~replication.runner.multiverse.Multiverse`) whose every run
+        this record holds as this code computes it (:meth:`holds`), each as its view (:meth:`universe`)."""
+        views = {u.name: self.universe(multiverse.name, u.name) for u in multiverse.universes}
+        return {name: view for name, view in views.items()
+                if all(view.holds(multiverse.runs[name, e]) for e in multiverse.experiments)}
+
     def stale(self, runs: list[Run]) -> list[Run]:
         """The recorded runs among ``runs`` that other code or settings made (their recorded key is not
         the run's): the record shows what that code computed, not what this code would."""
