@@ -219,6 +219,7 @@ def run_multiverse(cfg: DictConfig) -> None:
           f"{distinct} distinct runs")
     store, runs = None, None
     recorded = recorded_universes(cfg, multiverse)
+    print(multiverse_forecast(cfg, multiverse, recorded, n_jobs), flush=True)
     try:
         # universe by universe, the default first: a multiverse stopped part-way (a session's end, a Ctrl-C)
         # leaves whole universes, which the record takes one by one (replication.record.write)
@@ -258,6 +259,36 @@ def recorded_universes(cfg: DictConfig, multiverse) -> dict:
     from replication.record.runs import Record
 
     return Record(resolve(cfg.record)).universes_held(multiverse)
+
+
+def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int) -> str:
+    """How many of the multiverse's runs are left to compute (neither in the store nor in a universe read from
+    the record) and, at paper scale, roughly how long: each at the mean time the record gives its method and
+    condition in the default universe (the base experiments), over the workers."""
+    from joblib import effective_n_jobs
+
+    from replication.record.runs import Record
+    from replication.runner.execute import duration
+    from replication.runner.store import Store
+
+    left = {}
+    for universe in multiverse.universes:
+        for experiment in multiverse.experiments if universe.name not in recorded else ():
+            store = Store(resolve(cfg.store), experiment)
+            left.update((run.run_id, run) for run in multiverse.runs[universe.name, experiment]
+                        if not (store.path(run).exists() or store.failure_path(run).exists()))
+    said = f"{multiverse.name}: {len(left):,} runs to compute"
+    base = [run for experiment in multiverse.experiments for run in multiverse.runs["default", experiment]]
+    record = Record(resolve(cfg.record))  # the base experiments' records, else the default universe's
+    times = {**record.seconds(base), **record.universe(multiverse.name, "default").seconds(base)} \
+        if cfg.scale == "paper" and left else {}
+    timed = [times[key] for key in ((r.experiment, r.method, str(r.condition)) for r in left.values()) if key in times]
+    if not timed:
+        return said
+    workers = min(effective_n_jobs(n_jobs), len(left))
+    unknown = f"; {len(left) - len(timed):,} with no recorded time not counted" if len(timed) < len(left) else ""
+    return (f"{said}, about {duration(sum(timed) / workers)} on {workers} worker(s) (from the record's times of "
+            f"the same methods and conditions{unknown})")
 
 
 def run_companions(cfg: DictConfig) -> None:

@@ -142,6 +142,15 @@ class Record:
         found = self.found(runs)
         return len(found) == len(runs) and all(row["run_key"] == run.key for run, row in found)
 
+    def seconds(self, runs: list[Run]) -> dict[tuple[str, str, str], float]:
+        """The mean recorded wall time of ``runs`` by experiment, method and condition (those recorded with
+        a time)."""
+        times: dict[tuple[str, str, str], list[float]] = {}
+        for run, found in self.found(runs):
+            if found.get("wall_s") is not None:
+                times.setdefault((run.experiment, run.method, str(run.condition)), []).append(found["wall_s"])
+        return {key: sum(values) / len(values) for key, values in times.items()}
+
     def universes_held(self, multiverse) -> dict[str, "Record"]:
         """The universes of ``multiverse`` (a :class:`~replication.runner.multiverse.Multiverse`) whose every run
         this record holds as this code computes it (:meth:`holds`), each as its view (:meth:`universe`)."""

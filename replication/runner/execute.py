@@ -244,10 +244,11 @@ def forecast(runs: list[Run], pending: list[Run], store: Store, n_jobs: int, sam
         return f"{said} (no stored run of it to time them by)"
     workers = min(effective_n_jobs(n_jobs) if n_jobs else 1, len(pending))
     seconds = sum(np.mean(seen[run.method, str(run.condition)] or known) for run in pending) / max(workers, 1)
-    return f"{said}, about {_duration(seconds)} on {workers} worker(s) (from {len(known)} stored runs' times)"
+    return f"{said}, about {duration(seconds)} on {workers} worker(s) (from {len(known)} stored runs' times)"
 
 
-def _duration(seconds: float) -> str:
+def duration(seconds: float) -> str:
+    """A rough duration in the unit a reader wants: seconds, minutes or hours."""
     return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
 
 
