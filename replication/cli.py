@@ -37,7 +37,7 @@ from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project
 from replication.runner.lifeline import (
     child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
 )
-from replication.runner.preflight import check_yaml, preflight, written_experiment
+from replication.runner.preflight import check_yaml, preflight
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
 MULTIRUN_FLAGS = ("--multirun", "-m")
@@ -75,19 +75,16 @@ def experiment_file(name: str, argv: list[str]) -> Path:
     raise ConfigError(f"unknown experiment {name!r}; known: {', '.join(experiment_names(*config_dirs(argv)))}")
 
 
-def chosen_experiments(argv: list[str]) -> list[str]:
+def chosen_experiments(argv: list[str]) -> dict[str, dict]:
     """The experiments the command line names (several in a multirun), each checked to exist and to
-    parse; none for Hydra's own flags, which describe the app rather than run it."""
+    parse, with its file as written; none for Hydra's own flags, which describe the app rather than run it."""
     chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
     if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
-        return []
+        return {}
     if not chosen:
         known = ", ".join(experiment_names(*config_dirs(argv)))
         raise ConfigError(f"name an experiment: pf-replicate experiment=<name>; known: {known}")
-    names = chosen[-1].split(",")
-    for name in names:
-        check_yaml(experiment_file(name, argv))
-    return names
+    return {name: check_yaml(experiment_file(name, argv)) for name in chosen[-1].split(",")}
 
 
 def own_claims(argv: list[str]) -> list[str]:
@@ -106,8 +103,8 @@ def check_request(argv: list[str]) -> None:
     from hydra import compose, initialize_config_dir
     from hydra.errors import HydraException
 
-    names = chosen_experiments(argv)
-    if not names or any(arg in HYDRA_FLAGS for arg in argv):
+    written = chosen_experiments(argv)
+    if not written or any(arg in HYDRA_FLAGS for arg in argv):
         return
     multirun = any(arg in MULTIRUN_FLAGS for arg in argv)
     flag_values = {i + 1 for i, arg in enumerate(argv) if arg in FLAGS_WITH_VALUES}
@@ -119,7 +116,7 @@ def check_request(argv: list[str]) -> None:
     ]
     dirs = [str(Path(d).resolve()) for d in config_dirs(argv)]
     searchpath = [f"hydra.searchpath=[{','.join(f'file://{d}' for d in dirs)}]"] if dirs else []
-    for name in names:
+    for name in written:
         try:
             with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
                 cfg = compose("config", overrides=[f"experiment={name}", *overrides, *searchpath])
@@ -132,7 +129,7 @@ def check_request(argv: list[str]) -> None:
                     f"unknown key {key!r} (check the spelling; a key the config lacks is added as +{key}=...)"
                 ) from None
             raise ConfigError(" ".join(lines) or error.__class__.__name__) from None
-        preflight(cfg, written_experiment(experiment_file(name, argv)))
+        preflight(cfg, written[name])
 
 
 def interrupted(store=None, runs=None) -> None:
@@ -271,10 +268,10 @@ def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int
     from replication.runner.execute import duration
     from replication.runner.store import Store
 
-    left = {}
+    stores, left = {e: Store(resolve(cfg.store), e) for e in multiverse.experiments}, {}
     for universe in multiverse.universes:
-        for experiment in multiverse.experiments if universe.name not in recorded else ():
-            store = Store(resolve(cfg.store), experiment)
+        for experiment, store in stores.items() if universe.name not in recorded else ():
+            # a file's presence, not its soundness (Store.has reads it): a forecast reads no records
             left.update((run.run_id, run) for run in multiverse.runs[universe.name, experiment]
                         if not (store.path(run).exists() or store.failure_path(run).exists()))
     said = f"{multiverse.name}: {len(left):,} runs to compute"

@@ -240,10 +240,10 @@ def test_a_misspelt_sequence_of_ones_own_fails_in_one_line(tmp_path, args, named
 def test_every_shipped_experiment_passes_the_preflight(make_cfg, scale):
     """The checks refuse nothing the project ships (their rules are about values, not about our configs)."""
     from replication.paths import experiment_names
-    from replication.runner.preflight import preflight, written_experiment
+    from replication.runner.preflight import check_yaml, preflight
 
     for name in experiment_names():
-        written = written_experiment(summary.CONF_DIR / "experiment" / f"{name}.yaml")
+        written = check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
         preflight(make_cfg(name, f"scale={scale}", "outside_project=true"), written)
 
 

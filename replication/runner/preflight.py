@@ -34,8 +34,9 @@ NAMED_BLOCKS = ("methods", "scenes")  # their keys become file and folder names
 BEYOND, MOST_RUNS = 10, 10_000  # runs per condition beyond which a request must say force=true
 
 
-def check_yaml(path: Path) -> None:
-    """An experiment file parses (else its file and line) and holds a mapping."""
+def check_yaml(path: Path) -> dict:
+    """An experiment file parses (else its file and line) and holds a mapping: that mapping, as written
+    (before Hydra applies any override)."""
     try:
         data = yaml.safe_load(path.read_text())
     except yaml.MarkedYAMLError as error:
@@ -47,12 +48,7 @@ def check_yaml(path: Path) -> None:
     if not isinstance(data, dict):
         what = "is empty" if data is None else f"holds a {type(data).__name__}, not a mapping of settings"
         raise ConfigError(f"{path} {what}")
-
-
-def written_experiment(path: Path) -> dict:
-    """An experiment file as written (checked by :func:`check_yaml`), before Hydra applies any override."""
-    check_yaml(path)
-    return yaml.safe_load(path.read_text())
+    return data
 
 
 def check_settings(cfg: DictConfig) -> None:
@@ -175,7 +171,7 @@ def check_numbers(value: Any, where: str, key: str = "") -> None:
 
 def preflight(cfg: DictConfig, written: dict | None = None) -> None:
     """Every check of this module, in the order a user would fix them; ``written``: the experiment's file
-    as written (:func:`written_experiment`), whose run counts overrides are measured against."""
+    as written (:func:`check_yaml`), whose run counts overrides are measured against."""
     runs = (written or {}).get("runs")
     check_experiment(cfg, runs.get("paper") if isinstance(runs, dict) else None)
     check_settings(cfg)
