@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 MOTIONS = ("random_walk", "constant_velocity")
 NOISE_ON = ("velocity", "position")  # where a constant-velocity model's disturbance enters
@@ -63,6 +64,8 @@ class BoxModel:
         if (self.step_sd < 0).any() or (self.initial_sd < 0).any() or self.accel_sd < 0:
             raise ValueError("noise standard deviations must be non-negative")
         self.dim = 4 if self.kind == "random_walk" else 6
+        self.noise_factor = self._noise_factor()
+        self._sources = _noise_sources(self.noise_factor, 4 if self.kind == "random_walk" else 2)
 
     @property
     def x0(self) -> np.ndarray:
@@ -82,8 +85,7 @@ class BoxModel:
         moved[:, :2] += particles[:, 4:6] * self.period
         return moved
 
-    @property
-    def noise_factor(self) -> np.ndarray:
+    def _noise_factor(self) -> np.ndarray:
         """W of x_t = A x_{t-1} + W e, e ~ N(0, I): (d, 4) (eq 14: accelerations of x and y, size steps;
         with noise on position, steps of the centre that leave v alone)."""
         if self.kind == "random_walk":
@@ -108,11 +110,14 @@ class BoxModel:
         return self.constrain(particles)
 
     def propagate(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray:
-        """x_t = A x_{t-1} + W e; a constant-velocity model draws the accelerations, then the size steps."""
-        n = len(particles)
-        e = rng.standard_normal((n, 4)) if self.kind == "random_walk" else np.hstack(
-            [rng.standard_normal((n, 2)), rng.standard_normal((n, 2))])
-        return self.constrain(self.f(particles, t) + e @ self.noise_factor.T)
+        """x_t = A x_{t-1} + W e, sizes kept at least ``min_size``; a constant-velocity model draws the
+        accelerations (N, 2), then the size steps (N, 2), in one call as one (2, N, 2) block: the same
+        numbers in the same order.  One compiled pass (:func:`_moved`) gives ``constrain(f(x) + e @ W.T)``
+        to the bit."""
+        blocks, width = self._sources[0], self._sources[1]
+        draws = rng.standard_normal((blocks, len(particles), width))
+        return _moved(particles, draws, *self._sources[2:], self.kind == "constant_velocity", float(self.period),
+                      float(self.min_size))
 
     def propose(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | float]:
         """Draw x_t from the proposal given x_{t-1} = ``particles``, with log p(x_t | x_{t-1}) / q(x_t | ...),
@@ -151,3 +156,37 @@ class BoxModel:
         """(x, y, w, h) boxes of states (..., >= 4) given as (cx, cy, w, h, ...)."""
         states = np.asarray(states)
         return np.concatenate([states[..., :2] - states[..., 2:4] / 2.0, states[..., 2:4]], axis=-1)
+
+
+def _noise_sources(factor: np.ndarray, width: int) -> tuple:
+    """W (d, k) as one noise term per coordinate, for :func:`_moved`: (blocks, width) of the draws
+    (k = blocks * width normals drawn as (blocks, N, width), e_i = its (block, column) entries side by
+    side, as ``np.hstack`` joins them) and, per coordinate j, the block and column of the term W_j. e
+    reads and its coefficient (0 for a coordinate without noise: a fixed size)."""
+    if ((factor != 0).sum(axis=1) > 1).any():
+        raise AssertionError("a coordinate takes more than one noise term")  # cannot happen: eq 14 and the random walk
+    source = np.argmax(factor != 0, axis=1)
+    return (factor.shape[1] // width, width, (source // width).astype(np.int64), (source % width).astype(np.int64),
+            factor[np.arange(len(factor)), source].astype(float))
+
+
+@njit(cache=True, error_model="numpy")
+def _moved(particles, draws, block, column, scale, constant_velocity, period, min_size):
+    """``constrain(f(x) + e @ W.T)`` in one pass: coordinate j of a particle is f_j(x) (x_j, plus v_j T for a
+    constant-velocity centre) plus W_js e_s, its one noise term, and a size below ``min_size`` is raised to it.
+
+    Bit for bit the matrix form: each row of W has one non-zero entry, so (e W^T)_j is the rounded product
+    W_js e_s whatever the order of the dot product (the other terms add exact zeros), added to f_j(x) as numpy
+    adds it; the clamp keeps NaN, as ``np.maximum`` does."""
+    n, d = particles.shape
+    out = np.empty((n, d))
+    for i in range(n):
+        for j in range(d):
+            x = particles[i, j]
+            if constant_velocity and j < 2:
+                x = x + particles[i, j + 4] * period
+            x = x + draws[block[j], i, column[j]] * scale[j]
+            if (j == 2 or j == 3) and x < min_size:
+                x = min_size
+            out[i, j] = x
+    return out

@@ -189,34 +189,51 @@ class _Object:
     depth: float
     target: int | None
 
+    @cached_property
+    def sizes(self) -> np.ndarray:
+        """(T, 2) width and height of the sprite in every frame before any rotation: scaled, rounded half
+        to even (as ``round``), at least 2 px."""
+        h, w = self.sprites["front"][1].shape
+        return np.maximum(np.rint(np.multiply.outer(self.scales, (w, h))), 2.0).astype(np.int64)
+
+    @cached_property
+    def box(self) -> np.ndarray:
+        """(T, 4) top-left corner and size of the sprite as :meth:`drawn` places it in every frame: a rotated
+        sprite's canvas where it is turned, the corner the centre less half the size rounded half to even."""
+        sizes = self.sizes.copy()
+        for k in np.flatnonzero(self.angles != 0):
+            sizes[k] = _rotated_size(*sizes[k].tolist(), self.angles[k])
+        return np.concatenate([np.rint(self.centres - sizes / 2).astype(np.int64), sizes], axis=1)
+
     def drawn(self, k: int) -> tuple[np.ndarray, np.ndarray, int, int]:
         """Colour, alpha and top-left corner of the object in frame k."""
-        front_image, alpha = self.sprites["front"]
-        w, h = alpha.shape[1], alpha.shape[0]
-        sw, sh = max(int(round(w * self.scales[k])), 2), max(int(round(h * self.scales[k])), 2)
-        image = front_image
+        image, alpha = self.sprites["front"]
         if self.turned[k] > 0:
-            image = (1 - self.turned[k]) * front_image + self.turned[k] * self.sprites["back"][0]
-        if (sw, sh) != (w, h):
+            image = (1 - self.turned[k]) * image + self.turned[k] * self.sprites["back"][0]
+        sw, sh = self.sizes[k].tolist()
+        if (sw, sh) != (alpha.shape[1], alpha.shape[0]):
             image = cv2.resize(image, (sw, sh), interpolation=cv2.INTER_LINEAR)
             alpha = cv2.resize(alpha, (sw, sh), interpolation=cv2.INTER_LINEAR)
         if self.angles[k] != 0:
             image, alpha = _rotated(image, alpha, self.angles[k])
-            sh, sw = alpha.shape
-        x0 = int(round(self.centres[k, 0] - sw / 2))
-        y0 = int(round(self.centres[k, 1] - sh / 2))
+        x0, y0 = self.box[k, :2].tolist()
         return image, alpha, x0, y0
 
 
 def _rotated(image: np.ndarray, alpha: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
     """A sprite turned by ``degrees`` (anticlockwise) about its centre, on the smallest canvas that holds it."""
     h, w = alpha.shape
-    cos, sin = abs(np.cos(np.radians(degrees))), abs(np.sin(np.radians(degrees)))
-    nw, nh = (int(np.ceil(v - 1e-6)) for v in (w * cos + h * sin, w * sin + h * cos))
+    nw, nh = _rotated_size(w, h, degrees)
     turn = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), float(degrees), 1.0)
     turn[:, 2] += ((nw - w) / 2, (nh - h) / 2)
     return (cv2.warpAffine(image, turn, (nw, nh), flags=cv2.INTER_LINEAR),
             cv2.warpAffine(alpha, turn, (nw, nh), flags=cv2.INTER_LINEAR))
+
+
+def _rotated_size(w: int, h: int, degrees: float) -> tuple[int, int]:
+    """Width and height of the smallest canvas that holds a w x h sprite turned by ``degrees``."""
+    cos, sin = abs(np.cos(np.radians(degrees))), abs(np.sin(np.radians(degrees)))
+    return tuple(int(np.ceil(v - 1e-6)) for v in (w * cos + h * sin, w * sin + h * cos))
 
 
 def _clip(x0: int, y0: int, w: int, h: int, width: int, height: int):
@@ -260,7 +277,7 @@ class SyntheticScene:
         if self.camera_noise > 0:  # one bank of noise; frame k reads it from its own random offset
             pixels = self.size[0] * self.size[1] * 3
             self._noise = self.camera_noise * rng.standard_normal(pixels + NOISE_OFFSETS, dtype=np.float32)
-        self.truth = np.stack([self._boxes(obj) for obj in self.objects if obj.target is not None], axis=1)
+        self.truth = np.stack([obj.box.astype(float) for obj in self.objects if obj.target is not None], axis=1)
 
     def _object(self, spec: dict, target: int | None, rng: np.random.Generator) -> _Object:
         frames = np.arange(self.n_frames)
@@ -312,19 +329,13 @@ class SyntheticScene:
                 region[:] = region * (1 - alpha[..., None]) + patch * alpha[..., None]
         return np.clip(image, 0, 255).astype(np.float32)
 
-    def _boxes(self, obj: _Object) -> np.ndarray:
-        boxes = np.empty((self.n_frames, 4))
-        for k in range(self.n_frames):
-            _, alpha, x0, y0 = obj.drawn(k)
-            boxes[k] = (x0, y0, alpha.shape[1], alpha.shape[0])
-        return boxes
-
     def frame(self, k: int) -> np.ndarray:
         """Frame k as uint8 BGR: background, objects far to near, illumination, camera noise."""
         if not 0 <= k < self.n_frames:
             raise IndexError(f"frame {k} outside 0..{self.n_frames - 1}")
         width, height = self.size
-        image = self.background.copy()
+        image = self._canvas
+        np.copyto(image, self.background)
         for index in self.order:
             colour, alpha, x0, y0 = self.objects[index].drawn(k)
             overlap = _clip(x0, y0, alpha.shape[1], alpha.shape[0], width, height)
@@ -338,7 +349,13 @@ class SyntheticScene:
         if self.camera_noise > 0:
             offset = int(np.random.default_rng([self.seed, 1, k]).integers(NOISE_OFFSETS))
             image += self._noise[offset : offset + image.size].reshape(image.shape)
-        return np.clip(image, 0, 255).astype(np.uint8)
+        return np.clip(image, 0, 255, out=image).astype(np.uint8)
+
+    @cached_property
+    def _canvas(self) -> np.ndarray:
+        """The float frame :meth:`frame` composes in, one per scene: a new 2 MB array per frame costs more in
+        page faults than the drawing (the allocator can hand such arrays back to the system each time)."""
+        return np.empty_like(self.background)
 
     @cached_property
     def visibility(self) -> np.ndarray:
@@ -346,8 +363,9 @@ class SyntheticScene:
         width, height = self.size
         n_targets = self.truth.shape[1]
         visibility = np.zeros((self.n_frames, n_targets))
+        labels = np.empty((height, width), np.intp)  # one buffer, of bincount's own type: no copy per frame
         for k in range(self.n_frames):
-            labels = np.full((height, width), -1, np.int32)
+            labels.fill(n_targets)  # n_targets: background or an occluder
             areas = np.zeros(n_targets)
             for index in self.order:
                 obj = self.objects[index]
@@ -359,7 +377,7 @@ class SyntheticScene:
                 if overlap is None:
                     continue
                 inside, part = overlap
-                labels[inside][solid[part]] = -1 if obj.target is None else obj.target
-            counts = np.bincount(labels.ravel() + 1, minlength=n_targets + 1)[1:]
+                labels[inside][solid[part]] = n_targets if obj.target is None else obj.target
+            counts = np.bincount(labels.ravel(), minlength=n_targets + 1)[:n_targets]
             visibility[k] = np.divide(counts, areas, out=np.zeros(n_targets), where=areas > 0)
         return visibility

@@ -129,8 +129,9 @@ class Summaries:
     degenerate: list = field(default_factory=list)
 
     def add(self, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
-        self.means.append(weighted_mean(particles, weights))
-        self.variances.append(weighted_variance(particles, weights))
+        mean = weighted_mean(particles, weights)
+        self.means.append(mean)
+        self.variances.append(weighted_variance(particles, weights, mean))
         self.ess.append(ess(weights))
         self.degenerate.append(degenerate)
 

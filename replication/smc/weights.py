@@ -53,9 +53,9 @@ def weighted_mean(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     return weights @ particles
 
 
-def weighted_variance(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Per-coordinate weighted variance ``sum W_i (x_i - mean)^2``."""
-    return weights @ _squared_deviation(particles, weighted_mean(particles, weights))
+def weighted_variance(particles: np.ndarray, weights: np.ndarray, mean: np.ndarray | None = None) -> np.ndarray:
+    """Per-coordinate weighted variance ``sum W_i (x_i - mean)^2`` (``mean``: the weighted mean, if known)."""
+    return weights @ _squared_deviation(particles, weighted_mean(particles, weights) if mean is None else mean)
 
 
 @elementwise("float64(float64, float64)")
