@@ -42,16 +42,13 @@ GROUP = 8  # boxes the compiled kernel reads side by side (see _bhattacharyya_ke
 BLOCK_SAMPLES = 100_000  # sample points per bincount: big enough to amortise the calls, small enough for cache
 
 
-_SUM_CHANNELS = np.ones((1, 3), np.float32)
-
-
 @lru_cache(maxsize=16)
 def _contributions(bins: tuple[int, int, int]) -> np.ndarray:
-    """(256, 1, 3) uint16 table: channel value -> its term in the joint bin index (OpenCV HSV ranges)."""
+    """(256, 3) uint16 table: channel value -> its term in the joint bin index (OpenCV HSV ranges)."""
     bh, bs, bv = bins
     rows = [np.minimum(np.arange(256) * n // top, n - 1) * stride
             for n, top, stride in ((bh, 180, bs * bv), (bs, 256, bv), (bv, 256, 1))]
-    return np.stack(rows, axis=-1)[:, None, :].astype(np.uint16)
+    return np.stack(rows, axis=-1).astype(np.uint16)
 
 
 def hsv_bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
@@ -77,8 +74,19 @@ _BIN_IMAGES: dict = {}  # id of a read-only frame -> (weak reference to it, {bin
 
 
 def _bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
-    terms = cv2.LUT(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(bins))
-    return cv2.transform(terms, _SUM_CHANNELS)
+    return _joint_bins(cv2.cvtColor(frame, cv2.COLOR_BGR2HSV), _contributions(bins))
+
+
+@njit(cache=True)
+def _joint_bins(hsv, terms):
+    """Each pixel's ``terms[h, 0] + terms[s, 1] + terms[v, 2]``, in one pass over the HSV image (what
+    ``cv2.LUT`` then ``cv2.transform`` with weights (1, 1, 1) give in two: the sum is below 65536, exact)."""
+    height, width = hsv.shape[0], hsv.shape[1]
+    out = np.empty((height, width), np.uint16)
+    for y in range(height):
+        for x in range(width):
+            out[y, x] = terms[hsv[y, x, 0], 0] + terms[hsv[y, x, 1], 1] + terms[hsv[y, x, 2], 2]
+    return out
 
 
 _LARGEST_BIN: list = [None, 0]  # (weak reference to) the last bin image checked, and its largest bin
