@@ -376,6 +376,84 @@ def _pixel_offsets(boxes, b, us, vs, width, height, column, g, row):
     return inside
 
 
+@njit(cache=True)
+def _same_pattern(boxes, us, vs, width, height):
+    """source[b]: the first box whose samples fall on the same pixels as box b's (b itself if none, or if
+    that cannot be told safely).  Such boxes have the same counts and total, so the kernel reads one of them.
+
+    Only boxes of one size are compared (a fixed-size model's cloud, where a quarter of 400 particles' boxes,
+    or fewer, fall on pixels another box has: pixels are coarser than the cloud); boxes of drifting sizes
+    almost never do, and get source[b] = b at no cost.  With one size, sample i of a box with corner o (its
+    centre less half a pixel, float32, as :func:`_pixel_offsets` has it) reads pixel rint(o + s_i), s_i the
+    sample's offset; writing o = n + f (n an integer, 0 <= f < 1), that pixel is n + a constant + [f >= beta_i]
+    with beta_i = 1 - frac(s_i + 1/2), unless o + s_i lies within rounding of a half pixel.  So the pattern
+    of a box is fixed by (n, #{i : beta_i <= f}) on each axis (:func:`_cell`), and a box whose f lies within
+    ``eps`` of a beta_i or of 0 or 1 (eps far above float32's rounding of o + s_i) is left alone."""
+    n = boxes.shape[0]
+    source = np.arange(n)
+    for b in range(1, n):
+        if boxes[b, 2] != boxes[0, 2] or boxes[b, 3] != boxes[0, 3]:
+            return source
+    half, two = np.float32(0.5), np.float32(2.0)
+    beta_x, reach_x = _edges_of_cells(us, np.float32(boxes[0, 2]) / two)
+    beta_y, reach_y = _edges_of_cells(vs, np.float32(boxes[0, 3]) / two)
+    keys = np.empty((n, 4), np.int64)
+    slots = 1
+    while slots < 2 * n:
+        slots *= 2
+    table = np.full(slots, -1, np.int64)  # open addressing: a box of each cell seen
+    for b in range(n):
+        column, count_x, safe_x = _cell(np.float64(np.float32(boxes[b, 0]) - half), beta_x, reach_x)
+        row, count_y, safe_y = _cell(np.float64(np.float32(boxes[b, 1]) - half), beta_y, reach_y)
+        if not (safe_x and safe_y):
+            continue
+        keys[b, 0], keys[b, 1], keys[b, 2], keys[b, 3] = column, count_x, row, count_y
+        h = uint64(column) * uint64(0x9E3779B97F4A7C15) ^ uint64(row) * uint64(0xC2B2AE3D27D4EB4F)
+        h ^= uint64(count_x * 64 + count_y) * uint64(0x165667B19E3779F9)
+        slot = np.int64(h >> uint64(32)) & (slots - 1)
+        while table[slot] >= 0:
+            other = table[slot]
+            if (keys[other, 0] == column and keys[other, 1] == count_x and keys[other, 2] == row
+                    and keys[other, 3] == count_y):
+                source[b] = other
+                break
+            slot = (slot + 1) & (slots - 1)
+        if source[b] == b:
+            table[slot] = b
+    return source
+
+
+@njit(cache=True)
+def _edges_of_cells(offsets, scale):
+    """The sorted beta_i = 1 - frac(s_i + 1/2) of a box's samples s_i = offsets_i * scale (float32, as
+    :func:`_pixel_offsets` forms them; exact in float64), and the largest |s_i|."""
+    beta = np.empty(offsets.size)
+    reach = 0.0
+    for i in range(offsets.size):
+        shift = np.float64(offsets[i] * scale) + 0.5
+        beta[i] = 1.0 - (shift - np.floor(shift))
+        reach = max(reach, abs(shift))
+    return np.sort(beta), reach
+
+
+@njit(cache=True, inline="always")
+def _cell(corner, beta, reach):
+    """(n, #{i : beta_i <= f}, safe) of a box corner o = n + f, f past every beta_i counted as n + 1 and none
+    (the same pixels); safe when f lies farther than eps from 0, 1 and every beta_i, eps = 1e-6 (|o| +
+    max |s_i| + 1): sixteen times float32's rounding of o + s_i."""
+    whole = np.floor(corner)
+    f = corner - whole
+    nearest = min(f, 1.0 - f)
+    count = 0
+    for i in range(beta.size):
+        nearest = min(nearest, abs(f - beta[i]))
+        count += f >= beta[i]
+    safe = nearest > 1e-6 * (abs(corner) + reach + 1.0) and abs(whole) < 2.0**52
+    if count == beta.size:
+        whole, count = whole + 1.0, 0
+    return np.int64(whole) if safe else 0, count, safe
+
+
 @njit(cache=True, error_model="numpy")  # IEEE division: a zero-size diagonal-kernel box gives NaN, as numpy does
 def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column, first_sample, weights,
                           one_minus_v2, u2_minus_v2, diagonal, total_weight, program, root):
@@ -402,11 +480,13 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
     whole = np.full(GROUP, total_weight)  # the kernel's weight over all the samples of each box
     stack = np.empty(64)
     G = uint64(GROUP)
-    for start in range(0, n, GROUP):
-        m = min(GROUP, n - start)
+    source = _same_pattern(boxes, us, vs, width, height)
+    todo = np.flatnonzero(source == np.arange(n))  # one box of each pattern
+    for start in range(0, todo.size, GROUP):
+        m = min(GROUP, todo.size - start)
         fast = m == GROUP
         for g in range(m):
-            b = start + g
+            b = todo[start + g]
             if not _pixel_offsets(boxes, b, us, vs, width, height, column, g, row[g]):
                 fast = False
             if diagonal:  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
@@ -477,6 +557,8 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
             if total <= 1e-9 * whole[g]:  # nothing inside, up to rounding
                 total = 0.0
             s = np.nan if np.isnan(outside) else acc[g]  # a NaN weight outside (zero-size diagonal box): NaN, as numpy's dot
-            rho[start + g] = s / np.sqrt(total if total > 0 else 1.0)
-            valid[start + g] = total > 0
+            rho[todo[start + g]] = s / np.sqrt(total if total > 0 else 1.0)
+            valid[todo[start + g]] = total > 0
+    for b in range(n):  # a box on another's pixels has its histogram
+        rho[b], valid[b] = rho[source[b]], valid[source[b]]
     return rho, valid
