@@ -86,6 +86,20 @@ def _chain(targets, proposals, log_like, initial, initial_like, log_uniforms, ad
     return accepted, score
 
 
+@njit(cache=True)
+def _held(accepted, targets, m):
+    """held[k, i]: the row of target i's state after chain step k, its last accepted proposal k' <= k (row
+    k'), or its initial state (row total + i) if none yet."""
+    total = targets.size
+    held = np.empty((total, m), np.intp)
+    last = total + np.arange(m)
+    for k in range(total):
+        if accepted[k]:
+            last[targets[k]] = k
+        held[k] = last
+    return held
+
+
 @dataclass
 class MCMCPF(JointFilter):
     n_particles: int = 6000  # samples kept per frame after burn-in
@@ -135,12 +149,7 @@ class MCMCPF(JointFilter):
         for i, j in neighbours(reachable):
             adjacent[i, j] = adjacent[j, i] = True
         accepted, score = _chain(targets, proposals, log_like, initial, initial_like, np.log(rng.random(total)), adjacent, self.beta)
-        # the state after step k holds, for each target, its last accepted proposal (or its initial state)
-        steps = np.arange(total)
-        held = np.empty((total, m), dtype=np.intp)
-        for i in range(m):
-            last = np.maximum.accumulate(np.where(accepted & (targets == i), steps, -1))
-            held[:, i] = np.where(last >= 0, last, total + i)
+        held = _held(accepted, targets, m)
         rows = np.concatenate([proposals, initial])
         kept = rows[held[burn:].T]  # (M, N, d): each target's samples contiguous
         best = np.argsort(score[burn:])[-self.carry :]
