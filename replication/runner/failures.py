@@ -39,8 +39,8 @@ SHOWN = 3  # numbers named in a reason
 def failure(record: dict) -> str | None:
     """Why ``record`` (a task's metrics) cannot be stored, e.g. ``not finite: rmse=nan``; None if it can."""
     bad = {}
-    for key, value in _numbers(record):
-        if not math.isfinite(value) and key not in UNDEFINED:
+    for key, value in _non_finite(record):
+        if key not in UNDEFINED:
             bad.setdefault(key, value)
     if not bad:
         return None
@@ -49,16 +49,33 @@ def failure(record: dict) -> str | None:
     return f"not finite: {shown}" + (f" and {len(bad) - SHOWN} more" if len(bad) > SHOWN else "")
 
 
-def _numbers(value, key: str = "") -> Iterator[tuple[str, float]]:
-    """Every float in ``value`` with its key (nested keys joined by dots; a list's items share its key)."""
+def _non_finite(value, key: str = "") -> Iterator[tuple[str, float]]:
+    """Every float in ``value`` that is not finite, with its key (nested keys joined by dots; a list's items
+    share its key), in the order of the record.  A list of numbers (a per-frame series, nested or not) is
+    checked as one array; a list holding anything else (None, strings, mappings) item by item."""
     if isinstance(value, dict):
         for name, item in value.items():
-            yield from _numbers(item, f"{key}.{name}" if key else str(name))
+            yield from _non_finite(item, f"{key}.{name}" if key else str(name))
     elif isinstance(value, (list, tuple)):
-        for item in value:
-            yield from _numbers(item, key)
-    elif isinstance(value, (float, np.floating)):
+        numbers = _numeric(value)
+        if numbers is None:
+            for item in value:
+                yield from _non_finite(item, key)
+        elif numbers.dtype.kind == "f":  # ints and booleans are finite
+            for item in numbers[~np.isfinite(numbers)]:
+                yield key, float(item)
+    elif isinstance(value, (float, np.floating)) and not math.isfinite(value):
         yield key, float(value)
+
+
+def _numeric(items: list | tuple) -> np.ndarray | None:
+    """``items`` as one array (row-major, the order of the list) if they are all numbers in a regular
+    nesting, else None."""
+    try:
+        array = np.asarray(items)
+    except ValueError:  # ragged
+        return None
+    return array.reshape(-1) if array.dtype.kind in "fiub" else None
 
 
 def exit_if_failed(store: Store, runs: list[Run]) -> None:

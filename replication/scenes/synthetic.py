@@ -56,6 +56,7 @@ from functools import cached_property
 
 import cv2
 import numpy as np
+from numba import njit
 
 SHAPES = ("ellipse", "box", "ball", "head")
 BACKGROUNDS = ("flat", "gradient", "noise", "clutter")
@@ -236,12 +237,58 @@ def _rotated_size(w: int, h: int, degrees: float) -> tuple[int, int]:
     return tuple(int(np.ceil(v - 1e-6)) for v in (w * cos + h * sin, w * sin + h * cos))
 
 
-def _clip(x0: int, y0: int, w: int, h: int, width: int, height: int):
-    """Slices of the frame and of a (h, w) sprite at (x0, y0) for their overlap, or None."""
-    fx0, fy0, fx1, fy1 = max(x0, 0), max(y0, 0), min(x0 + w, width), min(y0 + h, height)
-    if fx0 >= fx1 or fy0 >= fy1:
-        return None
-    return (slice(fy0, fy1), slice(fx0, fx1)), (slice(fy0 - y0, fy1 - y0), slice(fx0 - x0, fx1 - x0))
+@njit(cache=True)
+def _composite(image, colour, alpha, x0, y0):
+    """``image <- image (1 - a) + colour a`` over the pixels of a sprite at (x0, y0) that lie in the frame,
+    in numpy's types and order: (1 - a) in alpha's type, each product in its operands' type, the sum
+    rounded to the image's float32."""
+    height, width = image.shape[0], image.shape[1]
+    one = np.float32(1.0)
+    for y in range(max(y0, 0), min(y0 + alpha.shape[0], height)):
+        for x in range(max(x0, 0), min(x0 + alpha.shape[1], width)):
+            a = alpha[y - y0, x - x0]
+            keep = one - a
+            for c in range(3):
+                image[y, x, c] = image[y, x, c] * keep + colour[y - y0, x - x0, c] * a
+    return image
+
+
+@njit(cache=True)
+def _exposed(image, noise):
+    """``np.clip(image + noise, 0, 255).astype(np.uint8)`` in one pass over float32 arrays: the float32 sum,
+    clipped, truncated to uint8, as numpy computes each step."""
+    out = np.empty(image.shape, np.uint8)
+    flat_in, flat_noise, flat_out = image.reshape(-1), noise.reshape(-1), out.reshape(-1)
+    for i in range(flat_in.size):
+        x = flat_in[i] + flat_noise[i]
+        flat_out[i] = np.uint8(0.0 if x < 0 else (255.0 if x > 255 else x))
+    return out
+
+
+@njit(cache=True)
+def _label(labels, alpha, x0, y0, value):
+    """``value`` into ``labels`` where the sprite at (x0, y0) is solid (alpha > 0.5) inside the frame; the
+    sprite's solid pixels, inside the frame or not."""
+    height, width = labels.shape
+    solid = 0
+    for y in range(alpha.shape[0]):
+        for x in range(alpha.shape[1]):
+            if alpha[y, x] > 0.5:
+                solid += 1
+                if 0 <= y + y0 < height and 0 <= x + x0 < width:
+                    labels[y + y0, x + x0] = value
+    return solid
+
+
+@njit(cache=True)
+def _count(labels, alpha, x0, y0, value):
+    """The pixels labelled ``value`` under the sprite's box at (x0, y0) (where ``value`` can be)."""
+    height, width = labels.shape
+    found = 0
+    for y in range(max(y0, 0), min(y0 + alpha.shape[0], height)):
+        for x in range(max(x0, 0), min(x0 + alpha.shape[1], width)):
+            found += labels[y, x] == value
+    return found
 
 
 class SyntheticScene:
@@ -333,22 +380,16 @@ class SyntheticScene:
         """Frame k as uint8 BGR: background, objects far to near, illumination, camera noise."""
         if not 0 <= k < self.n_frames:
             raise IndexError(f"frame {k} outside 0..{self.n_frames - 1}")
-        width, height = self.size
         image = self._canvas
         np.copyto(image, self.background)
         for index in self.order:
             colour, alpha, x0, y0 = self.objects[index].drawn(k)
-            overlap = _clip(x0, y0, alpha.shape[1], alpha.shape[0], width, height)
-            if overlap is None:
-                continue
-            inside, part = overlap
-            a = alpha[part][..., None]
-            image[inside] = image[inside] * (1.0 - a) + colour[part] * a
+            _composite(image, colour, alpha, x0, y0)
         if self.gain[k] != 1.0:
             image *= self.gain[k]
         if self.camera_noise > 0:
             offset = int(np.random.default_rng([self.seed, 1, k]).integers(NOISE_OFFSETS))
-            image += self._noise[offset : offset + image.size].reshape(image.shape)
+            return _exposed(image, self._noise[offset : offset + image.size].reshape(image.shape))
         return np.clip(image, 0, 255, out=image).astype(np.uint8)
 
     @cached_property
@@ -363,21 +404,18 @@ class SyntheticScene:
         width, height = self.size
         n_targets = self.truth.shape[1]
         visibility = np.zeros((self.n_frames, n_targets))
-        labels = np.empty((height, width), np.intp)  # one buffer, of bincount's own type: no copy per frame
+        labels = np.full((height, width), n_targets, np.intp)  # n_targets: background or an occluder
         for k in range(self.n_frames):
-            labels.fill(n_targets)  # n_targets: background or an occluder
-            areas = np.zeros(n_targets)
-            for index in self.order:
-                obj = self.objects[index]
-                _, alpha, x0, y0 = obj.drawn(k)
-                solid = alpha > 0.5
+            areas, counts = np.zeros(n_targets), np.zeros(n_targets)
+            placed = [(self.objects[index], *self.objects[index].drawn(k)[1:]) for index in self.order]
+            for obj, alpha, x0, y0 in placed:  # far to near: the nearest label stays
+                solid = _label(labels, alpha, x0, y0, n_targets if obj.target is None else obj.target)
                 if obj.target is not None:
-                    areas[obj.target] = solid.sum()
-                overlap = _clip(x0, y0, alpha.shape[1], alpha.shape[0], width, height)
-                if overlap is None:
-                    continue
-                inside, part = overlap
-                labels[inside][solid[part]] = n_targets if obj.target is None else obj.target
-            counts = np.bincount(labels.ravel(), minlength=n_targets + 1)[:n_targets]
+                    areas[obj.target] = solid
+            for obj, alpha, x0, y0 in placed:
+                if obj.target is not None:
+                    counts[obj.target] = _count(labels, alpha, x0, y0, obj.target)
+            for _, alpha, x0, y0 in placed:
+                _label(labels, np.ones_like(alpha), x0, y0, n_targets)  # the background again, where sprites lay
             visibility[k] = np.divide(counts, areas, out=np.zeros(n_targets), where=areas > 0)
         return visibility
