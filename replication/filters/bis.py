@@ -38,7 +38,7 @@ from replication.smc.loop import (
     model_proposal,
 )
 from replication.filters.joint import JointFilter, JointState
-from replication.smc.resampling import multinomial
+from replication.smc.resampling import inverse_cdf_rows, multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
 
 
@@ -94,17 +94,19 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
     """The marginal posteriors W_i (eq 10) from K joint bootstrap draws weighted by the MRF (eqs 5-8, 11).
 
     The draws B_i(k) are each target's K uniforms, drawn target after target, through the linear
-    inverse CDF of :func:`~replication.smc.resampling.multinomial`; the potentials of the
+    inverse CDF of :func:`~replication.smc.resampling.multinomial` (for targets of one N, all rows in
+    one call: :func:`~replication.smc.resampling.inverse_cdf_rows`); the potentials of the
     neighbouring pairs and the K-draw tallies are compiled loops over the drawn indices
     (:func:`_draw_log_potential`, :func:`_tally`), with no (K, 4) copy of each target's drawn
     states; the arithmetic and its order are those of :func:`pairwise_log_potential` and
     ``np.bincount``, so the histograms are the same to the bit.
     """
-    draws = np.stack([multinomial(p, rng, size=k) for p in pi])  # B_i(k), eq (5)
     pairs = np.array(neighbours(particles), dtype=np.int64).reshape(-1, 2)  # eq (8); draws lie in their clouds
     if len({len(p) for p in particles}) == 1:
+        draws = inverse_cdf_rows(np.stack(pi), rng.random((len(pi), k)))  # B_i(k), eq (5): one pass for all targets
         log_w = _draw_log_potential(np.stack(particles).astype(float, copy=False), draws, pairs, float(beta))
     else:  # targets with different N: the numpy form
+        draws = np.stack([multinomial(p, rng, size=k) for p in pi])
         log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
     tallies = _tally(draws, w, max(len(p) for p in particles))

@@ -64,6 +64,30 @@ def inverse_cdf(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     return _search(cumulative, uniforms, searchable)
 
 
+def inverse_cdf_rows(weights: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
+    """:func:`inverse_cdf` of each row of ``weights`` (M, N) with the same row of ``uniforms`` (M, K), in one
+    compiled pass over the rows (:func:`_rows_inverse_cdf`): (M, K) indices, row i exactly inverse_cdf's."""
+    weights, uniforms = np.ascontiguousarray(weights, dtype=float), np.ascontiguousarray(uniforms, dtype=float)
+    out = np.empty(uniforms.shape, np.int64)
+    searched = _rows_inverse_cdf(weights, uniforms, np.empty(weights.shape[1]),
+                                 np.empty(4 * weights.shape[1] + 1, np.int64), out)
+    for i in np.flatnonzero(~searched):  # C not searchable (NaN weights): numpy's search, as inverse_cdf
+        out[i] = np.searchsorted(cumulative_weights(weights[i]), uniforms[i], side="right")
+    return out
+
+
+@njit(cache=True)
+def _rows_inverse_cdf(weights, uniforms, cumulative, guide, out):
+    """Row by row, C of the weights (:func:`_fill_cumulative`) and the guided search of the uniforms in it
+    into ``out``; whether each row's C was searchable (a row that was not is left to numpy)."""
+    searched = np.zeros(weights.shape[0], np.bool_)
+    for i in range(weights.shape[0]):
+        if _fill_cumulative(weights[i], cumulative):
+            _guided_search(cumulative, uniforms[i], guide, out[i])
+            searched[i] = True
+    return searched
+
+
 def search(cumulative: np.ndarray, uniforms: np.ndarray) -> np.ndarray:
     """``np.searchsorted(cumulative, uniforms, side="right")`` as int64, in O(N + K) (:func:`_guided_search`)."""
     return _search(cumulative, uniforms, bool(len(cumulative)) and _searchable(cumulative))

@@ -10,6 +10,8 @@ a Gaussian in the Bhattacharyya distance d = sqrt(1 - rho).
 
 import numpy as np
 
+from replication.compiled import elementwise
+
 
 def bhattacharyya(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """rho[p, q] = sum_u sqrt(p_u q_u) over the last axis (ism_pf eq 32); 0 for an empty histogram."""
@@ -29,5 +31,11 @@ def gaussian_similarity_log_likelihood(similarity: np.ndarray, sigma: float, val
     """
     if sigma <= 0:
         raise ValueError(f"sigma must be positive, got {sigma}")
-    log_like = -(1.0 - similarity) / (2.0 * sigma**2) - np.log(np.sqrt(2.0 * np.pi) * sigma)
-    return log_like if valid is None else np.where(valid, log_like, -np.inf)
+    return _gaussian_log(similarity, True if valid is None else valid, 2.0 * sigma**2,
+                         np.log(np.sqrt(2.0 * np.pi) * sigma))
+
+
+@elementwise("float64(float64, boolean, float64, float64)")
+def _gaussian_log(similarity, valid, two_variance, log_norm):
+    """-(1 - s) / (2 sigma^2) - log(sqrt(2 pi) sigma) where valid, else -inf: one pass, numpy's order."""
+    return -(1.0 - similarity) / two_variance - log_norm if valid else -np.inf
