@@ -392,3 +392,19 @@ def test_mcmc_leaves_still_balls_only_when_it_carries_its_10_best_samples_with_n
     for reading in ("experiment.methods.MCMC.carry=1500", "experiment.model.motion.noise_on=position"):
         record = _on_still_balls("MCMC", small, reading)
         assert max(record["per_frame"]["cle"]) < 20.0 and record["outside_frames"] == 0, reading
+
+
+def test_the_chains_held_states_are_the_last_accepted_proposal_of_each_target():
+    """MCMC-PF's held[k, i] (compiled): target i's last accepted proposal up to step k, else its initial
+    state's row (total + i), as the numpy scan it replaced computes it."""
+    from replication.filters.mcmc import _held
+
+    rng = np.random.default_rng(2)
+    for m, total in [(1, 1), (3, 50), (16, 7500)]:
+        targets, accepted = rng.integers(m, size=total), rng.random(total) < 0.3
+        steps = np.arange(total)
+        expected = np.empty((total, m), dtype=np.intp)
+        for i in range(m):
+            last = np.maximum.accumulate(np.where(accepted & (targets == i), steps, -1))
+            expected[:, i] = np.where(last >= 0, last, total + i)
+        np.testing.assert_array_equal(_held(accepted, targets, m), expected)

@@ -66,3 +66,43 @@ def test_failed_runs_are_recorded_counted_and_not_rerun(cli, tmp_path):
     assert again.returncode == FAILED_STATUS and again.stderr.strip().splitlines()[-1] == line, again.stderr
     assert "0 runs computed, 6 already stored" in again.stdout
     assert [p.stat().st_mtime_ns for p in failed] == written
+
+
+def test_the_check_reads_series_as_arrays_and_finds_what_an_item_by_item_walk_finds():
+    """failure() checks a list of numbers as one array; on nested records with None, strings, ints, booleans,
+    ragged lists and non-finite numbers anywhere, it gives the reason an item-by-item walk gives."""
+    def walk(value, key=""):
+        if isinstance(value, dict):
+            for name, item in value.items():
+                yield from walk(item, f"{key}.{name}" if key else str(name))
+        elif isinstance(value, (list, tuple)):
+            for item in value:
+                yield from walk(item, key)
+        elif isinstance(value, (float, np.floating)):
+            yield key, float(value)
+
+    def by_walk(record):
+        bad = {}
+        for key, value in walk(record):
+            if not math.isfinite(value) and key not in UNDEFINED:
+                bad.setdefault(key, value)
+        return sorted(bad.items(), key=lambda item: "." in item[0])
+
+    rng = np.random.default_rng(0)
+    odd = [NAN, INF, -INF, None, "x", 3, True, 2.5]
+    for _ in range(300):
+        def item(depth):
+            roll = rng.random()
+            if depth < 3 and roll < 0.3:
+                return [item(depth + 1) for _ in range(int(rng.integers(0, 4)))]
+            if depth < 3 and roll < 0.4:
+                return {f"k{i}": item(depth + 1) for i in range(int(rng.integers(1, 3)))}
+            if roll < 0.55:
+                return rng.normal(size=(int(rng.integers(1, 4)), 3)).tolist()  # a regular series
+            return odd[int(rng.integers(len(odd)))] if roll < 0.8 else float(rng.normal())
+        record = {f"m{i}": item(0) for i in range(4)}
+        expected = by_walk(record)
+        reason = failure(record)
+        assert (reason is None) == (not expected)
+        if expected:
+            assert reason.startswith("not finite: " + f"{expected[0][0]}={expected[0][1]}")

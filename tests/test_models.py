@@ -146,3 +146,26 @@ def test_bis_pf_tracks_the_balls_with_boxes_of_their_size():
     run = next(r for r in runs if r.method == "BIS-PF" and r.condition.get("scene") == "exp2_16_targets")
     boxes = np.asarray(TASKS[run.task].run(run)["per_frame"]["box"], dtype=float)
     assert boxes.shape[1] == 16 and (boxes[..., 2:4] == 20.0).all()
+
+
+@pytest.mark.parametrize("kind", ["random_walk", "constant_velocity"])
+@pytest.mark.parametrize("noise_on", ["velocity", "position"])
+@pytest.mark.parametrize("size", ["drifting", "fixed"])
+def test_the_compiled_box_motion_is_the_matrix_form_to_the_bit(kind, noise_on, size):
+    """propagate = constrain(f(x) + e @ W.T) with e the same normals (a constant-velocity model's two (N, 2)
+    blocks drawn as one (2, N, 2) call), bit for bit: each row of W has one non-zero entry."""
+    from replication.models.box import BoxModel
+
+    model = BoxModel(np.array([50.0, 40.0, 20.0, 16.0]), None, kind=kind, noise_on=noise_on, size=size, accel_sd=0.63,
+                     period=1.5, step_sd=(4.0, 3.0, 0.5, 0.1), min_size=15.0)
+    rng = np.random.default_rng(1)
+    particles = model.sample_initial(300, rng)
+    particles[::7, 2:4] = 15.0  # sizes at the clamp
+    for t in range(1, 30):
+        replay = np.random.default_rng(t)
+        blocks = [replay.standard_normal((300, 4))] if kind == "random_walk" else [
+            replay.standard_normal((300, 2)), replay.standard_normal((300, 2))]
+        expected = model.constrain(model.f(particles, t) + np.hstack(blocks) @ model.noise_factor.T)
+        moved = model.propagate(particles[::-1][::-1], t, np.random.default_rng(t))  # any layout
+        assert moved.tobytes() == expected.tobytes()
+        particles = moved

@@ -70,3 +70,19 @@ def test_systematic_at_the_edges_is_searchsorted():
                 expected = np.searchsorted(cumulative, (np.arange(n) + first) / n, side="right")
                 found = _systematic_search(cumulative, first, np.zeros(n + 1, np.int64), np.empty(n, np.int64))
                 np.testing.assert_array_equal(found, expected)
+
+
+def test_rows_of_weights_are_each_inverse_cdf():
+    """inverse_cdf_rows (BIS-PF's bootstrap draws for all targets at once) is inverse_cdf row by row, a row
+    of NaN weights (numpy's search) and all-zero weights included."""
+    from replication.smc.resampling import inverse_cdf, inverse_cdf_rows
+
+    rng = np.random.default_rng(6)
+    for m, n, k in [(1, 1, 1), (3, 10, 50), (36, 400, 4000), (5, 7, 0)]:
+        weights = rng.dirichlet(np.full(n, 0.3), size=m)
+        if m > 2:
+            weights[1] = np.nan
+            weights[2] = 0.0
+        uniforms = rng.random((m, k))
+        expected = np.stack([inverse_cdf(w, u) for w, u in zip(weights, uniforms)])
+        np.testing.assert_array_equal(inverse_cdf_rows(weights, uniforms), expected)

@@ -276,3 +276,61 @@ def test_the_scenes_command_refuses_a_bad_request_in_one_line(argv, said, capsys
     with pytest.raises(SystemExit) as stopped:
         main(argv)
     assert stopped.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_frames_and_visibility_are_numpys_compositing_to_the_bit():
+    """Every synthetic scene of the experiments (and one turning, scaling, changing sprite): each frame is the
+    numpy compositing it replaced (background, each sprite blended far to near as image (1 - a) + colour a,
+    gain, the camera noise, clipped and cast), and the visibility is the share of each target's solid pixels
+    a full-frame label buffer gives it."""
+    import glob
+
+    import yaml
+
+    from replication.scenes.synthetic import NOISE_OFFSETS
+
+    def composed(scene, k):
+        image = scene.background.copy()
+        height, width = image.shape[:2]
+        for index in scene.order:
+            colour, alpha, x0, y0 = scene.objects[index].drawn(k)
+            fy0, fx0 = max(y0, 0), max(x0, 0)
+            fy1, fx1 = min(y0 + alpha.shape[0], height), min(x0 + alpha.shape[1], width)
+            if fy0 < fy1 and fx0 < fx1:
+                a = alpha[fy0 - y0 : fy1 - y0, fx0 - x0 : fx1 - x0][..., None]
+                part = colour[fy0 - y0 : fy1 - y0, fx0 - x0 : fx1 - x0]
+                image[fy0:fy1, fx0:fx1] = image[fy0:fy1, fx0:fx1] * (1.0 - a) + part * a
+        image *= scene.gain[k]
+        if scene.camera_noise > 0:
+            offset = int(np.random.default_rng([scene.seed, 1, k]).integers(NOISE_OFFSETS))
+            image += scene._noise[offset : offset + image.size].reshape(image.shape)
+        return np.clip(image, 0, 255).astype(np.uint8)
+
+    def labelled(scene, k):
+        height, width = scene.background.shape[:2]
+        labels, areas = np.full((height, width), -1), np.zeros(scene.truth.shape[1])
+        for index in scene.order:
+            obj = scene.objects[index]
+            _, alpha, x0, y0 = obj.drawn(k)
+            ys, xs = np.nonzero(alpha > 0.5)
+            if obj.target is not None:
+                areas[obj.target] = len(ys)
+            inside = (ys + y0 >= 0) & (ys + y0 < height) & (xs + x0 >= 0) & (xs + x0 < width)
+            labels[ys[inside] + y0, xs[inside] + x0] = -1 if obj.target is None else obj.target
+        counts = np.bincount(labels.ravel() + 1, minlength=len(areas) + 1)[1:]
+        return np.divide(counts, areas, out=np.zeros(len(areas)), where=areas > 0)
+
+    specs = []
+    for path in sorted(glob.glob(str(PROJECT_ROOT / "replication/conf/experiment/*.yaml"))):
+        for spec in ((yaml.safe_load(open(path)) or {}).get("scenes") or {}).values():
+            if isinstance(spec, dict) and spec.get("kind") == "synthetic":
+                specs.append({k: v["quick"] if isinstance(v, dict) and "quick" in v else v for k, v in spec.items()})
+    turning = dict(specs[0], frames=40)
+    turning["targets"] = [dict(t, rotation=[[0, 0.0], [20, 37.0], [39, -95.5]], scale=[[0, 1.0], [39, 1.6]],
+                               appearance=[{"to": "back", "start": 5, "end": 30}]) for t in turning["targets"]]
+    assert len(specs) >= 10
+    for spec in [*specs, turning]:
+        scene = SyntheticScene(dict(spec, frames=min(int(spec["frames"]), 40)))
+        for k in range(scene.n_frames):
+            assert scene.frame(k).tobytes() == composed(scene, k).tobytes()
+            np.testing.assert_array_equal(scene.visibility[k], labelled(scene, k))
