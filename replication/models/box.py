@@ -22,7 +22,7 @@ with ``prepare(frame)`` and ``log_likelihood(boxes, prepared)``).
 """
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -64,8 +64,8 @@ class BoxModel:
         if (self.step_sd < 0).any() or (self.initial_sd < 0).any() or self.accel_sd < 0:
             raise ValueError("noise standard deviations must be non-negative")
         self.dim = 4 if self.kind == "random_walk" else 6
-        self.noise_factor = self._noise_factor()
-        self._sources = _noise_sources(self.noise_factor, 4 if self.kind == "random_walk" else 2)
+        self.noise_factor = self._noise_factor()  # W, fixed by the settings: built once
+        self._sources = NoiseSources.of(self.noise_factor, 4 if self.kind == "random_walk" else 2)
 
     @property
     def x0(self) -> np.ndarray:
@@ -114,10 +114,10 @@ class BoxModel:
         accelerations (N, 2), then the size steps (N, 2), in one call as one (2, N, 2) block: the same
         numbers in the same order.  One compiled pass (:func:`_moved`) gives ``constrain(f(x) + e @ W.T)``
         to the bit."""
-        blocks, width = self._sources[0], self._sources[1]
-        draws = rng.standard_normal((blocks, len(particles), width))
-        return _moved(particles, draws, *self._sources[2:], self.kind == "constant_velocity", float(self.period),
-                      float(self.min_size))
+        sources = self._sources
+        draws = rng.standard_normal((sources.blocks, len(particles), sources.width))
+        return _moved(particles, draws, sources.block, sources.column, sources.scale, self.kind == "constant_velocity",
+                      float(self.period), float(self.min_size))
 
     def propose(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | float]:
         """Draw x_t from the proposal given x_{t-1} = ``particles``, with log p(x_t | x_{t-1}) / q(x_t | ...),
@@ -158,16 +158,25 @@ class BoxModel:
         return np.concatenate([states[..., :2] - states[..., 2:4] / 2.0, states[..., 2:4]], axis=-1)
 
 
-def _noise_sources(factor: np.ndarray, width: int) -> tuple:
-    """W (d, k) as one noise term per coordinate, for :func:`_moved`: (blocks, width) of the draws
-    (k = blocks * width normals drawn as (blocks, N, width), e_i = its (block, column) entries side by
-    side, as ``np.hstack`` joins them) and, per coordinate j, the block and column of the term W_j. e
-    reads and its coefficient (0 for a coordinate without noise: a fixed size)."""
-    if ((factor != 0).sum(axis=1) > 1).any():
-        raise AssertionError("a coordinate takes more than one noise term")  # cannot happen: eq 14 and the random walk
-    source = np.argmax(factor != 0, axis=1)
-    return (factor.shape[1] // width, width, (source // width).astype(np.int64), (source % width).astype(np.int64),
-            factor[np.arange(len(factor)), source].astype(float))
+class NoiseSources(NamedTuple):
+    """W (d, k) as one noise term per coordinate, for :func:`_moved`: the k normals are drawn as ``blocks``
+    blocks of (N, ``width``) (e_i is a particle's rows of the blocks side by side, as ``np.hstack`` joins
+    them), and coordinate j takes the normal in ``block[j]``, ``column[j]`` times ``scale[j]`` (its one
+    non-zero entry of W, or 0 for a coordinate without noise: a fixed size)."""
+
+    blocks: int
+    width: int
+    block: np.ndarray
+    column: np.ndarray
+    scale: np.ndarray
+
+    @classmethod
+    def of(cls, factor: np.ndarray, width: int) -> "NoiseSources":
+        if ((factor != 0).sum(axis=1) > 1).any():
+            raise AssertionError("a coordinate takes more than one noise term")  # cannot happen: eq 14, the random walk
+        source = np.argmax(factor != 0, axis=1)
+        return cls(factor.shape[1] // width, width, (source // width).astype(np.int64),
+                   (source % width).astype(np.int64), factor[np.arange(len(factor)), source].astype(float))
 
 
 @njit(cache=True, error_model="numpy")

@@ -199,8 +199,9 @@ class _Object:
 
     @cached_property
     def box(self) -> np.ndarray:
-        """(T, 4) top-left corner and size of the sprite as :meth:`drawn` places it in every frame: a rotated
-        sprite's canvas where it is turned, the corner the centre less half the size rounded half to even."""
+        """(T, 4) top-left corner and size of the sprite as :meth:`drawn` places it in every frame (the scene's
+        truth): a rotated sprite's canvas where it is turned, the corner the centre less half the size rounded
+        half to even, as ``round`` rounds."""
         sizes = self.sizes.copy()
         for k in np.flatnonzero(self.angles != 0):
             sizes[k] = _rotated_size(*sizes[k].tolist(), self.angles[k])
@@ -217,8 +218,8 @@ class _Object:
             alpha = cv2.resize(alpha, (sw, sh), interpolation=cv2.INTER_LINEAR)
         if self.angles[k] != 0:
             image, alpha = _rotated(image, alpha, self.angles[k])
-        x0, y0 = self.box[k, :2].tolist()
-        return image, alpha, x0, y0
+        h, w = alpha.shape
+        return image, alpha, int(round(self.centres[k, 0] - w / 2)), int(round(self.centres[k, 1] - h / 2))
 
 
 def _rotated(image: np.ndarray, alpha: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
@@ -394,8 +395,9 @@ class SyntheticScene:
 
     @cached_property
     def _canvas(self) -> np.ndarray:
-        """The float frame :meth:`frame` composes in, one per scene: a new 2 MB array per frame costs more in
-        page faults than the drawing (the allocator can hand such arrays back to the system each time)."""
+        """The float frame :meth:`frame` composes in, one per scene (a process runs one run at a time: every
+        backend starts one thread per worker): a new 2 MB array per frame costs more in page faults than the
+        drawing (the allocator can hand such arrays back to the system each time)."""
         return np.empty_like(self.background)
 
     @cached_property

@@ -26,7 +26,9 @@ the (N, K) maps and (N, B) tallies of the vectorised numpy path (still there as
 against).  It picks the same pixels (float32 coordinates rounded half to even,
 as ``cv2.remap``'s nearest neighbour does) and adds the same weights in the same
 order per bin, so the counts are bit-identical; only the final dot product's
-order of summation differs from BLAS's (about 1e-16).
+order of summation differs from BLAS's (about 1e-16).  Boxes whose samples fall on
+the same pixels (most of a fixed-size particle cloud's: :func:`_same_pattern`) are
+read once, each getting the numbers it would get alone.
 """
 
 import weakref
