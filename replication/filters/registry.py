@@ -42,14 +42,10 @@ def builder(name: str) -> Callable:
     """The builder ``name`` names: an import path ``module:attribute`` or a registered entry point."""
     if not isinstance(name, str) or not name:
         raise ConfigError(f"filter must name a builder (a registered name or module:name), got {name!r}")
-    if ":" in name:
-        module, _, attribute = name.partition(":")
-        return _callable(name, _attribute(name, _module(name, module), attribute))
-    points = registered()
-    if name not in points:
-        raise ConfigError(f"unknown filter {name!r}; known filters: {', '.join(sorted(points))} "
+    if ":" not in name and name not in registered():
+        raise ConfigError(f"unknown filter {name!r}; known filters: {', '.join(sorted(registered()))} "
                           "(or an import path, module:name)")
-    module, _, attribute = points[name].value.partition(":")
+    module, _, attribute = (name if ":" in name else registered()[name].value).partition(":")
     return _callable(name, _attribute(name, _module(name, module), attribute))
 
 
