@@ -106,3 +106,24 @@ def test_the_check_reads_series_as_arrays_and_finds_what_an_item_by_item_walk_fi
         assert (reason is None) == (not expected)
         if expected:
             assert reason.startswith("not finite: " + f"{expected[0][0]}={expected[0][1]}")
+
+
+def test_a_run_during_which_numba_compiles_is_timed_again(make_cfg, monkeypatch):
+    """The first use of a kernel in a fresh checkout compiles it (seconds): that run is computed again and
+    its second record kept, so its times are the method's, not the compiler's; a run that compiles
+    nothing is computed once."""
+    from numba import njit
+
+    from replication.runner import execute
+
+    run = expand(make_cfg())[0]
+    calls, kernel = [], njit(lambda x: x + 1.0)  # no cache: compiled at its first call
+
+    class Compiling:  # a task whose first run compiles a new kernel
+        def run(self, run):
+            calls.append(kernel(1.0))
+            return {"rmse": 1.0, "calls": len(calls)}
+
+    monkeypatch.setitem(execute.TASKS, run.task, Compiling())
+    assert perform(run)["calls"] == 2 and len(calls) == 2  # compiled during the first: computed again
+    assert perform(run)["calls"] == 3 and len(calls) == 3  # compiled already: computed once
