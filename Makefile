@@ -91,7 +91,7 @@ verify: setup
 	$(BIN)/python -m replication verify N=$(N) n_jobs=$(JOBS)
 
 benchmark: setup
-	$(BIN)/python benchmarks/benchmark.py --instructions
+	$(BIN)/python benchmarks/benchmark.py --instructions --profiles
 	$(BIN)/python benchmarks/peers.py
 
 report: setup

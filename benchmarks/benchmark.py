@@ -14,6 +14,10 @@
 4. BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second
    against the paper's 5.52, a profile of where the time goes, and its time
    per frame against the number of targets M (the paper claims O(M)).
+6. With ``--profiles`` (``make benchmark``): where a paper-scale run's time goes in the three
+   experiments that cost the shipped record the most CPU, each profiled on the run of its costliest
+   method that took longest in the record (``profile_run.py``'s profile): its time per library and its
+   costliest functions.
 5. Issue 34's two ratios, each measured ROUNDS times in this run (median and
    range): the likelihood against the calcHist loop at N = 1000, the two
    timed in turn (>= 15), and BIS-PF against the paper's frame rate (>= 15);
@@ -58,6 +62,7 @@ from replication.paths import resolve  # noqa: E402
 from replication.report.pages.index import write_index  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.runner.memory import retain_freed_memory  # noqa: E402
+from profile_run import profiled, runs_of  # noqa: E402  (benchmarks/: the script's own folder)
 from replication.scenes import SyntheticScene  # noqa: E402
 from replication.smc.resampling import RESAMPLERS  # noqa: E402
 from replication.vision.colour import ColourLikelihood  # noqa: E402
@@ -311,6 +316,33 @@ def scaling_plot(scaling: pd.DataFrame, path) -> None:
     plt.close(fig)
 
 
+def slowest_profiles(record: Path, count: int = 3, top: int = 6) -> pd.DataFrame:
+    """The ``count`` experiments of the record with the most CPU (the sum of their runs' times), each with
+    the run of its costliest method that took longest, performed here under cProfile: its seconds, the
+    share of each library, and its ``top`` functions by own time."""
+    spent = {folder.name: pd.read_parquet(folder / "runs.parquet", columns=["method", "run_key", "wall_s"])
+             for folder in sorted(record.iterdir()) if (folder / "runs.parquet").exists()}
+    rows = []
+    for name in sorted(spent, key=lambda n: -spent[n]["wall_s"].sum())[:count]:
+        runs = spent[name]
+        method = runs.groupby("method")["wall_s"].sum().idxmax()
+        longest = runs[runs["method"] == method].sort_values("wall_s").iloc[-1]
+        run = next((r for r in runs_of(name, "paper") if r.key == longest["run_key"]), None)
+        row = {"experiment": name, "record CPU-minutes": runs["wall_s"].sum() / 60, "method": method,
+               "share of the experiment's CPU": runs.loc[runs["method"] == method, "wall_s"].sum()
+               / runs["wall_s"].sum(), "recorded s": longest["wall_s"]}
+        if run is None:  # the record was made by other code: its run is not this code's
+            rows.append({**row, "run": f"{longest['run_key']}: not in this code's runs (the record is older)"})
+            continue
+        seconds, shares, stats = profiled(run)
+        own = sorted(stats.stats.items(), key=lambda item: -item[1][2])[:top]
+        rows.append({**row, "run": run.run_id, "profiled s": seconds,
+                     **{f"{part} share": t / seconds for part, t in shares.most_common()},
+                     "costliest functions (own s)": "; ".join(f"{f} ({Path(file).name}:{line}) {v[2]:.2f}"
+                                                              for (file, line, f), v in own)})
+    return pd.DataFrame(rows)
+
+
 def main() -> None:
     retain_freed_memory()  # as every experiment's run does
     out = resolve("reports") / "benchmark"
@@ -322,9 +354,13 @@ def main() -> None:
           "instructions_per_particle": np.nan}])
     bis_speed, bis_profile, bis_scaling = bis_pf_36()
     summary = ratios(rounds, bis_speed, counted)
+    profiles = slowest_profiles(resolve("record")) if "--profiles" in sys.argv[1:] and resolve("record").is_dir() \
+        else pd.DataFrame([{"experiment": "not profiled in this run (make benchmark profiles them: benchmark.py "
+                                          "--profiles, about 2 min)"}])
     for name, table in (("likelihood", likelihood), ("likelihood_rounds", rounds), ("instructions", counted),
                         ("smc_core", core), ("rendering", render_cost), ("bis_pf_speed", bis_speed),
-                        ("bis_pf_profile", bis_profile), ("bis_pf_scaling", bis_scaling), ("ratios", summary)):
+                        ("bis_pf_profile", bis_profile), ("bis_pf_scaling", bis_scaling), ("ratios", summary),
+                        ("profiles", profiles)):
         table.to_csv(out / f"{name}.csv", index=False)
         print(table.to_string(index=False), end="\n\n")
     print(f"BIS-PF time per frame against M: slope {bis_scaling.attrs['slope']:.3f} ms per target, "
@@ -372,6 +408,10 @@ def main() -> None:
                  "figure": "bis_pf_scaling.png", "table": html_table(bis_scaling.round(3))},
                 {"title": "BIS-PF profile over 20 frames: where the time goes (self time per function)",
                  "figure": None, "table": html_table(bis_profile.round(4))},
+                {"title": "Where a paper-scale run's time goes: the three experiments that cost the shipped record "
+                          "the most CPU, each on the longest run of its costliest method, under cProfile (whose "
+                          "overhead is per Python call: shares of code making many small calls read high)",
+                 "figure": None, "table": html_table(profiles.round(3))},
             ],
         )
     )

@@ -37,6 +37,25 @@ def part(filename: str, function: str) -> str:
     return next((name for key, name in PARTS.items() if key in where), "Python")
 
 
+def profiled(run) -> tuple[float, Counter, pstats.Stats]:
+    """``run`` performed under cProfile: its seconds (every function's own time), those seconds per library
+    (:func:`part`), and the profile."""
+    profile = cProfile.Profile()
+    profile.runcall(perform, run)
+    stats = pstats.Stats(profile)
+    shares = Counter()
+    for (filename, _, function), row in stats.stats.items():
+        shares[part(filename, function)] += row[2]
+    return sum(shares.values()), shares, stats
+
+
+def runs_of(experiment: str, scale: str) -> list:
+    """The runs ``experiment`` expands to at ``scale``."""
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}"])
+    return expand(cfg)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("experiment")
@@ -45,19 +64,11 @@ def main() -> None:
     parser.add_argument("--scale", default="quick")
     parser.add_argument("--top", type=int, default=20)
     args = parser.parse_args()
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[f"experiment={args.experiment}", f"scale={args.scale}"])
-    runs = [run for run in expand(cfg) if run.method == args.method and run.repetition == 0
+    runs = [run for run in runs_of(args.experiment, args.scale) if run.method == args.method and run.repetition == 0
             and args.text in f"{run.condition} {run.data_condition}"]
     if not runs:
         sys.exit(f"{args.experiment} at {args.scale} scale has no run of {args.method!r} matching {args.text!r}")
-    profile = cProfile.Profile()
-    profile.runcall(perform, runs[0])
-    stats = pstats.Stats(profile)
-    total = sum(row[2] for row in stats.stats.values())  # own time of every function: the run's time
-    shares = Counter()
-    for (filename, _, function), row in stats.stats.items():
-        shares[part(filename, function)] += row[2]
+    total, shares, stats = profiled(runs[0])
     print(f"{runs[0].run_id}: {total:.1f} s under the profiler")
     print("  " + ", ".join(f"{name} {seconds / total:.0%}" for name, seconds in shares.most_common()))
     stats.sort_stats("tottime").print_stats(args.top)
