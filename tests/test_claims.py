@@ -183,6 +183,24 @@ def test_a_quoted_size_is_tested_against_ours():
     assert "ratio 0.381" in verdict.why
 
 
+def test_a_share_printed_in_percent_is_sized_in_percent():
+    """A share of frames (0..1 per run) shown in percentage points (scale 100) against a paper's 92.3 % and
+    77.3 %: a gap of 15 pp in ours is the paper's size, one of 8 pp falls short.  (The paper's numbers were
+    once tested against the runs' shares unscaled, so a gap equal to the paper's read as "size absent".)"""
+    metric = "correct_frames[iou>=0.5]"
+    spec = {"test": "order", "metric": metric, "order": ["A", "B"], "scale": 100, "unit": " pp",
+            "size": {"quoted": {"A": 92.3, "B": 77.3}}}
+    rng = np.random.default_rng(2)
+    for gap, outcome in ((0.15, Outcome.REPRODUCED), (0.08, Outcome.NOT_REPRODUCED)):
+        records = typed(pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
+                                       metric: share + 0.01 * rng.standard_normal()}
+                                      for r in range(30) for m, share in (("A", 0.7 + gap), ("B", 0.7))]))
+        checks = ClaimTest.of(spec, EXPERIMENT).checks(records, {})
+        assert Result.of(checks).verdict.outcome is outcome, gap
+        assert checks[0].paper == pytest.approx(15.0)  # the paper's gap, in the units ours is shown in
+        assert checks[0].estimate.value == pytest.approx(100 * gap, abs=1.0)
+
+
 def test_a_users_claim_quotes_its_own_numbers_for_the_size():
     """No published table: the reading quotes the pair, and the size is tested as a paper's is."""
     records = _records({"A": 0.0, "B": 0.2})

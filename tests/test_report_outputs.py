@@ -318,6 +318,10 @@ def test_pdf_has_the_summary_then_every_table_and_figure(reports):
     assert "Every published cell" in flat and "Table 1: RMSE of the state estimate" in flat
     assert flat.index("Scorecard") < flat.index("Every published cell")
     assert "Quick scale" in flat
+    # the first page opens on every claim at a glance (the experiments' table comes after the scorecard)
+    assert flat.index("each at a glance below") < flat.index("Scorecard") < flat.index("Experiments")
+    assert _valid_png(reports / "glance.png")[1] > 500
+    assert '<img class="glance" src="glance.png"' in (reports / "index.html").read_text()
 
 
 def _valid_png(path: Path) -> tuple[int, int]:

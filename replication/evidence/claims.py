@@ -20,7 +20,7 @@ first over several sequences, decided by its probability of ranking first) and
 import functools
 import itertools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -101,6 +101,9 @@ class Check:
     reference: float | None = None  # where the claim's line is: the paper's value, a bound, zero difference
     per_run: dict[int, float] = field(default_factory=dict)  # the statistic per repetition (for the multiverse)
     detail: str = ""  # what it was measured at (a budget, the work spent), shown beside ``what``, not its identity
+    paper: float | None = None  # the paper's own value of the number, where it quotes one (a sized order's gap
+    # better - worse in the units shown, a cell's published value, a threshold's bound): ours / paper's is the
+    # scorecard's common scale (1: as the paper says, 0: no effect)
 
     @property
     def shown(self) -> str:
@@ -163,8 +166,7 @@ def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) ->
     own = check.verdict
     why = f"{own.why}; not significant after Holm across {family} checks ({said_p(adjusted)})" \
         if own.outcome is Outcome.NOT_REPRODUCED else own.why
-    return Check(check.what, Verdict(outcome, why, own.p_for, own.p_against), check.estimate, check.unit,
-                 check.reference, check.per_run, check.detail)
+    return replace(check, verdict=Verdict(outcome, why, own.p_for, own.p_against))
 
 
 class ClaimTest:
@@ -235,11 +237,12 @@ class Order(ClaimTest):
                         continue
                     allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-                    verdict, difference = _order_check(better, worse, kind, scale, allowed,
-                                                       self.effect(a, b, condition))
+                    paper = self.effect(a, b, condition)
+                    verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
                     per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
                     work = _work(records, (a, b), condition) if kind.machine_dependent else ""  # beside a time
-                    found.append(Check(what, verdict, difference, unit, 0.0, per_run, work))
+                    found.append(Check(what, verdict, difference, unit, 0.0, per_run, work,
+                                       _shown_gap(paper)))
         return found
 
     def effect(self, better: str, worse: str, condition: str) -> Effect | None:
@@ -331,14 +334,20 @@ def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allo
     runs = len(better)
     binary = kind.proportion
     unit = kind.high * scale if binary else scale  # yes/no outcomes are tested as 0 or 1
-    as_rates = Effect(paper.better / unit, paper.worse / unit, "difference") if binary and paper else paper
+    # the paper's numbers are in the claim's units (a share printed in %, scale 100): tested in the runs' own
+    as_tested = Effect(paper.better / unit, paper.worse / unit, paper.kind) if paper else None
     tested = order_test(better * scale / unit, worse * scale / unit, kind.lower_is_better, binary,
-                        allowed * scale / unit, as_rates)
+                        allowed * scale / unit, as_tested)
     difference = _shown(tested.gain, unit * (-1 if kind.lower_is_better else 1), runs)
     few = too_few(runs)
     if few:
         return few, difference
     return _order_verdict(tested, paper, unit, binary), difference
+
+
+def _shown_gap(paper: Effect | None) -> float | None:
+    """The paper's gap better - worse, in the claim's units as ours is shown, where it quotes one as a difference."""
+    return None if paper is None or paper.kind != "difference" else paper.better - paper.worse
 
 
 def _shown(test: Test, factor: float, runs: int) -> Estimate:
@@ -389,7 +398,7 @@ class Cells(ClaimTest):
                 if cell.rating:  # a rating: the proportion of runs behind it is the number
                     what = f"{what} (ours: {cell.rating})"
                 found.append(Check(what, cell.verdict or Verdict(Outcome.NOT_TESTABLE), cell.estimate,
-                                   reference=cell.paper_number))
+                                   reference=cell.paper_number, paper=cell.paper_number))
         return found
 
 
@@ -422,7 +431,7 @@ class Threshold(ClaimTest):
         p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
         verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
         return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
-                      dict(zip(chosen["repetition"].astype(int), values)))]
+                      dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound))]
 
 
 def _threshold_verdict(p_for: float | None, p_against: float | None, against: str = "the other side of the bound",

@@ -1,4 +1,8 @@
-"""The published numbers, one row per table cell (``../shared/reference/published_values.csv``)."""
+"""The published numbers, one row per table cell.
+
+They ship with the package (:data:`PACKAGED`, a copy of ``../shared/reference/published_values.csv``
+that the tests hold equal to it), so an installed package judges the papers' claims from any folder.
+"""
 
 import warnings
 from functools import lru_cache
@@ -7,8 +11,16 @@ from pathlib import Path
 import pandas as pd
 
 from replication.condition import PREFIX
+from replication.paths import resolve
 
+PACKAGED = Path(__file__).with_name("published_values.csv")
 COLUMNS = ["paper", "table", "experiment", "method", "metric", "condition", "value", "unit", "note"]
+
+
+def published_path(configured: str | Path | None) -> Path:
+    """The file of published values a config names (``published_values``; relative to the project
+    directory), or the package's own (:data:`PACKAGED`) when it names none."""
+    return PACKAGED if configured is None else resolve(configured)
 
 
 @lru_cache(maxsize=4)

@@ -24,6 +24,7 @@ from hydra import compose, initialize_config_dir
 from joblib import Parallel, delayed
 
 from replication.errors import ConfigError, fail
+from replication.evidence.published import published_path
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest
@@ -91,7 +92,7 @@ def main(argv: list[str]) -> None:
     reports = resolve(cfg.reports)
     if source == "record":
         held = resolve(cfg.record)
-        drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", resolve(cfg.published_values)))
+        drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", published_path(cfg.published_values)))
         print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
     if switches["pdf"]:
         from replication.report.pdf import write_pdf
@@ -163,7 +164,7 @@ def findings(argv: list[str]) -> None:
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
     drawn = Drawn(resolve(settings["reports"]) / PAGES)
-    rendered_from = inputs(record, out / "templates", resolve(settings["published_values"]))
+    rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
     drawn_from = drawn.status.get("drawn_from") if (drawn.folder / STATUS).exists() else None
     if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture

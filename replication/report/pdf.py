@@ -30,8 +30,9 @@ import replication  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
-from replication.report.pages.index import TITLE, default_published_values  # noqa: E402
-from replication.evidence.published import load_published  # noqa: E402
+from replication.report.pages import glance  # noqa: E402
+from replication.report.pages.index import TITLE  # noqa: E402
+from replication.evidence.published import load_published, published_path  # noqa: E402
 from replication.evidence.claims import load_papers  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.evidence.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
@@ -58,7 +59,7 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     reports = Path(reports)
     summaries = load_summaries(reports)
     configs = experiment_configs()
-    published = load_published(str(resolve(published_values or default_published_values())))
+    published = load_published(str(published_path(published_values)))
     papers = load_papers()
     rows = claim_rows(papers, summaries)
     cells = summary_table(published, summaries, configs, owner_of_cells(papers, published))
@@ -69,12 +70,13 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
               f"the papers'. Paper scale: {PAPER_COMMAND}." if quick else None)
     tallies = cell_tallies(cells)
     with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path, banner) as pdf:
-        _title_page(pdf, summaries, cells, rows)
+        _title_page(pdf, summaries, cells, rows, glance.write(reports, papers, rows))
         for paper in papers:
             counted = ", ".join(f"{n} {outcome}" for outcome, n in tally(rows[paper.key]).items())
             _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key], tallies),
                          widths=SCORECARD_COLUMNS,
                          subtitle=f"{paper.authors}; {paper.venue} ({paper.key}). Claims: {counted}.")
+        _experiments_page(pdf, summaries)
         _table_pages(pdf, "How verdicts are made", pd.DataFrame({"rules": list(rules())}), widths={"rules": 200})
         _table_pages(pdf, "Every published cell", _summary_frame(cells), widths=SUMMARY_COLUMNS,
                      subtitle="One row per published value: ours and the verdict where a table of ours "
@@ -139,22 +141,36 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     })
 
 
-def _title_page(pdf: PdfPages, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict) -> None:
+def _title_page(pdf: PdfPages, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict, picture: Path) -> None:
+    """The title, the counts, and every claim at a glance (:mod:`~replication.report.pages.glance`)."""
     fig = plt.figure(figsize=PAGE)
-    fig.text(0.05, 0.92, TITLE, fontsize=18, weight="bold", va="top")
+    fig.text(0.05, 0.95, TITLE, fontsize=18, weight="bold", va="top")
     cell_tally = counts(cells)
     verdicts = ", ".join(f"{k}: {v}" for k, v in cell_tally["verdicts"].items())
     claims = [row for paper_rows in rows.values() for row in paper_rows]
     claim_tally = ", ".join(f"{n} {outcome}" for outcome, n in tally(claims).items())
     quick = [s for s in summaries.values() if s.scale != "paper"]
     lines = [
-        f"Generated {datetime.date.today().isoformat()} by replication {replication.__version__}.",
-        f"{len(claims)} claims of five papers tested ({claim_tally}): the scorecard follows, one page per paper.",
+        f"Generated {datetime.date.today().isoformat()} by replication {replication.__version__}. "
+        f"{len(claims)} claims of five papers tested ({claim_tally}), each at a glance below; the scorecard "
+        "follows, one page per paper, then the experiments.",
         f"{cell_tally['cells']} published cells; {cell_tally['compared']} compared with a table of ours"
         + (f" ({verdicts})" if verdicts else "") + "; the summary after the scorecard says why the others were not.",
     ] + ([f"{len(quick)} of {len(summaries)} experiments at the quick scale. " + scale_note("quick")] if quick else [])
-    fig.text(0.05, 0.85, "\n".join(textwrap.fill(line, 150) for line in lines), fontsize=10, va="top",
-             linespacing=1.5, parse_math=False)
+    fig.text(0.05, 0.89, "\n".join(textwrap.fill(line, 170) for line in lines), fontsize=8.5, va="top",
+             linespacing=1.4, parse_math=False)
+    ax = fig.add_axes((0.03, 0.04, 0.94, 0.72))
+    ax.imshow(mpimg.imread(picture), interpolation="antialiased")
+    ax.set_axis_off()
+    pdf.savefig(fig)
+    plt.close(fig)
+
+
+def _experiments_page(pdf: PdfPages, summaries: dict[str, Summary]) -> None:
+    """Every experiment with a report: its scale, runs and cell verdicts, and those with none yet."""
+    fig = plt.figure(figsize=PAGE)
+    _header(fig, "Experiments", "Each experiment's scale, stored runs and cell verdicts; its tables and figures "
+            "follow the summary of published cells")
     missing = [name for name in experiment_names() if name not in summaries]
     rows = [
         [s.title, s.scale, f"{s.n_records} / {s.n_runs}", ", ".join(f"{k}: {v}" for k, v in sorted(s.verdicts.items()))
@@ -164,7 +180,7 @@ def _title_page(pdf: PdfPages, summaries: dict[str, Summary], cells: pd.DataFram
     frame = pd.DataFrame(rows, columns=["experiment", "scale", "runs stored", "verdicts"])
     if len(frame):
         _draw_table(fig, frame, {"experiment": 95, "scale": 6, "runs stored": 11, "verdicts": 70},
-                    box=(0.05, 0.08, 0.90, 0.62))
+                    box=(0.05, 0.08, 0.90, 0.76))
     else:
         fig.text(0.05, 0.65, "No experiment has a report yet: run make replicate.", fontsize=11)
     if missing:

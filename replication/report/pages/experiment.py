@@ -18,7 +18,7 @@ from replication.evidence.settings import rules
 from replication.export import LAYOUTS, write_results
 from replication.paths import resolve
 from replication.report.figures import draw
-from replication.evidence.published import cells, load_published
+from replication.evidence.published import cells, load_published, published_path
 from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
@@ -34,7 +34,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     experiment, runs, records, failures = results.experiment, results.runs, results.records, results.failures
     out = resolve(cfg.reports) / results.name
     out.mkdir(parents=True, exist_ok=True)
-    published = load_published(str(resolve(cfg.published_values)))
+    published = load_published(str(published_path(cfg.published_values)))
     spec = experiment.get("report", {})
     tables, figures, built, left_out = [], [], {}, []
     files = results.write_tables(out)

@@ -9,13 +9,12 @@ The scorecard (:mod:`replication.evidence.scorecard`) is also written as
 import datetime
 from pathlib import Path
 
-from omegaconf import OmegaConf
-
 import replication
-from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.paths import experiment_names
 from replication.evidence.claims import load_papers
-from replication.evidence.published import load_published
+from replication.evidence.published import load_published, published_path
 from replication.record.manifest import PAGES
+from replication.report.pages import glance
 from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
@@ -25,11 +24,6 @@ from replication.evidence.summary import counts, experiment_configs, load_summar
 from replication.evidence.settings import rules
 
 TITLE = "Particle-filter tracking papers: replication report"
-
-
-def default_published_values() -> Path:
-    """The ``published_values`` of ``conf/config.yaml``, resolved from the project root."""
-    return resolve(OmegaConf.load(CONF_DIR / "config.yaml").published_values)
 
 
 def _scale_note(summaries: dict[str, Summary]) -> str | None:
@@ -66,7 +60,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     missing = [name for name in experiment_names() if name not in summaries]
     experiments = [_entry(name, summary) for name, summary in summaries.items()]
     own = [_entry(name, summary) for name, summary in load_summaries(reports, own=True).items()]
-    published = load_published(str(resolve(published_values or default_published_values())))
+    published = load_published(str(published_path(published_values)))
     papers = load_papers()
     rows = claim_rows(papers, summaries)
     record = recorded(reports, papers)
@@ -75,6 +69,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
     tallies = cell_tallies(cells)
     claims_frame(rows, cells, tallies).to_csv(reports / "claims.csv", index=False)
+    glance.write(reports, papers, rows)
     page = reports / "index.html"
     page.write_text(
         render(

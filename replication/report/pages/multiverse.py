@@ -20,7 +20,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
-from replication.evidence.published import load_published
+from replication.evidence.published import load_published, published_path
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
 from replication.paths import resolve
@@ -118,7 +118,7 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
     universe)`` holds the runs (the store by default; the paper-scale record's universe)."""
     out = resolve(cfg.reports) / multiverse.name
     out.mkdir(parents=True, exist_ok=True)
-    published = load_published(str(resolve(cfg.published_values)))
+    published = load_published(str(published_path(cfg.published_values)))
     store_of = store_of or (lambda name, universe: Store(resolve(cfg.store), name))
     robustness, n_records = evaluate_multiverse(multiverse, store_of, published)
     draw(robustness, multiverse, out / "readings.png")
