@@ -69,7 +69,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
     tallies = cell_tallies(cells)
     claims_frame(rows, cells, tallies).to_csv(reports / "claims.csv", index=False)
-    glance.write(reports, papers, rows)
+    glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
     page = reports / "index.html"
     page.write_text(
         render(
