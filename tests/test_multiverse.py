@@ -12,6 +12,7 @@ from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
 from replication.evidence.claims import EQUAL_N, Check, Claim, Reading, Result, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
+from replication.evidence.robustness import Pairing
 from replication.evidence.schema import Summary
 from replication.evidence.statistics import Estimate
 from replication.report.pages.multiverse import write_multiverse_report
@@ -123,10 +124,10 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
 
 
 def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", held: int = 1,
-          per_run: dict | None = None) -> Case:
+          per_run: dict | None = None, timed: bool = False) -> Case:
     checks = tuple(Check("A - B" if i == 0 else "other", Verdict(Outcome.REPRODUCED if i < held else outcome),
-                         per_run=dict(per_run or {}) if i == 0 else {}) for i in range(2))
-    deciding = Check("A - B", Verdict(outcome), Estimate(1.0, 0.5, 1.5, 10, "t"))
+                         per_run=dict(per_run or {}) if i == 0 else {}, timed=timed) for i in range(2))
+    deciding = Check("A - B", Verdict(outcome), Estimate(1.0, 0.5, 1.5, 10, "t"), timed=timed)
     return Case(universe, (*picks.items(), (READING, reading)), Result(Verdict(outcome), checks, deciding))
 
 
@@ -172,6 +173,26 @@ def test_a_choice_with_a_real_effect_that_moves_the_verdict_makes_it_depend_on_t
     assert "moved by x=b (+1" in robustness.summary and "best case for the paper: reproduced" in robustness.summary
     # between two inconclusive cases the one with more checks holding is closer
     assert Robustness(CLAIM, cases[2:]).best_case.universe == "y=b'"
+
+
+def test_a_time_that_moves_between_universes_is_no_effect_of_the_reading():
+    """Each universe's runs were timed when they ran: x=b's were slowed by a third (load) and x=c's verdict
+    conflicts with the default's.  No paired effect is estimated from times; x=b, which agrees, does not move
+    the verdict however far its times moved, and x=c does, as a conflicting decisive verdict."""
+    times = {r: 20 + v for r, v in RUNS.items()}  # ms per frame
+    slowed = {r: 3 * v for r, v in times.items()}
+    cases = (_case("default", {"x": "a"}, Outcome.REPRODUCED, per_run=times, timed=True),
+             _case("x=b", {"x": "b"}, Outcome.REPRODUCED, per_run=slowed, timed=True),
+             _case("x=c", {"x": "c"}, Outcome.NOT_REPRODUCED, per_run=slowed, timed=True))
+    effects = {e.alternative: e for e in Robustness(CLAIM, cases).effects}
+    assert all(e.effect is None and e.paired is Pairing.TIMES and e.paired.said for e in effects.values())
+    assert not effects["b"].moves and effects["c"].moves
+    assert Robustness(CLAIM, cases[:2]).summary == "robust: no open choice moves the verdict (1 alternatives, 2 cases)"
+    # the same numbers as a statistic measured the same way in every universe: x=b's effect is real
+    untimed = tuple(_case(c.universe, dict(c.picks[:1]), c.verdict.outcome, per_run=p)
+                    for c, p in zip(cases[:2], (times, slowed)))
+    (effect,) = Robustness(CLAIM, untimed).effects
+    assert effect.paired is Pairing.TWIN and effect.effect is not None and effect.significant
 
 
 def test_equal_cost_is_a_named_choice_of_its_own_twinned_with_its_universe_at_equal_n():

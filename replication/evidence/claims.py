@@ -104,6 +104,7 @@ class Check:
     paper: float | None = None  # the paper's own value of the number, where it quotes one (a sized order's gap
     # better - worse in the units shown, a cell's published value, a threshold's bound): ours / paper's is the
     # scorecard's common scale (1: as the paper says, 0: no effect)
+    timed: bool = False  # the number rests on times measured as the runs ran (machine- and load-dependent)
 
     @property
     def shown(self) -> str:
@@ -242,7 +243,7 @@ class Order(ClaimTest):
                     per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
                     work = _work(records, (a, b), condition) if kind.machine_dependent else ""  # beside a time
                     found.append(Check(what, verdict, difference, unit, 0.0, per_run, work,
-                                       _shown_gap(paper)))
+                                       _shown_gap(paper), kind.machine_dependent))
         return found
 
     def effect(self, better: str, worse: str, condition: str) -> Effect | None:
@@ -311,7 +312,8 @@ class EqualCost(ClaimTest):
             verdict, difference = _order_check(better, worse, quantity(metric), scale, 0.0, None)
             per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
             spends = f"budget {budget:.4g}; {baseline} at {chosen} spends {spent[chosen]:.4g}"
-            found.append(Check(what, verdict, difference, self.spec.get("unit", ""), 0.0, per_run, spends))
+            found.append(Check(what, verdict, difference, self.spec.get("unit", ""), 0.0, per_run, spends,
+                               timed=quantity(cost).machine_dependent))  # the baseline's N is chosen by time
         return found
 
 
@@ -431,7 +433,8 @@ class Threshold(ClaimTest):
         p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
         verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
         return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
-                      dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound))]
+                      dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound),
+                      timed=kind.machine_dependent)]
 
 
 def _threshold_verdict(p_for: float | None, p_against: float | None, against: str = "the other side of the bound",

@@ -9,7 +9,7 @@ import numpy as np
 
 from replication.evidence.claims import Check, Claim, Result
 from replication.evidence.inference import said_p
-from replication.evidence.robustness import DECISIVE, ChoiceEffect, adjust, paired_effect
+from replication.evidence.robustness import DECISIVE, ChoiceEffect, Pairing, adjust, paired_effect
 from replication.evidence.schema import RobustnessResult
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
@@ -79,10 +79,12 @@ class Robustness:
         twin (the case that differs only in that choice, set to its default; where a design has no twins,
         Sobol points, the default case), and how many of its cases' verdicts differ from the twin's.  A
         scoring reading, and a statistic with no per-run values (a published cell, a ranking), count only
-        conflicting decisive verdicts (reproduced against not reproduced).  A reading at equal cost is an
-        alternative of :data:`BASIS` (its twin: the same universe scored by the default reading), not of
-        :data:`READING`, whose alternatives are the readings at equal N."""
+        conflicting decisive verdicts (reproduced against not reproduced), and so does a time (a deciding check
+        :attr:`~replication.evidence.claims.Check.timed`: load, not the reading, may move it).  A reading at
+        equal cost is an alternative of :data:`BASIS` (its twin: the same universe scored by the default
+        reading), not of :data:`READING`, whose alternatives are the readings at equal N."""
         testable = self.testable
+        timed = self.default.deciding is not None and self.default.deciding.timed
         cases = {c.picks: c for c in testable}
         default_picks = dict(self.default.picks)
 
@@ -101,11 +103,12 @@ class Robustness:
                 continue
             twins = [(c, twin(c, choice)) for c in under]
             pairs = [(c, t) for c, t in twins if t is not None]
-            compared = "twin" if pairs else "default"
+            compared = Pairing.TWIN if pairs else Pairing.DEFAULT
             pairs = pairs or [(c, self.default) for c in under]
-            effect, p = (None, math.nan) if choice in SCORING else self._paired(pairs)
-            if choice in SCORING or effect is None:
-                compared = "readings"
+            unpaired = Pairing.READINGS if choice in SCORING else Pairing.TIMES if timed else None
+            effect, p = (None, math.nan) if unpaired else self._paired(pairs)
+            if unpaired or effect is None:
+                compared = unpaired or Pairing.VERDICTS
                 flips = sum({c.verdict.outcome, t.verdict.outcome} == DECISIVE for c, t in pairs)
             else:
                 flips = sum(c.verdict.outcome is not t.verdict.outcome for c, t in pairs)

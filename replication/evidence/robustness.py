@@ -14,11 +14,15 @@ show for it, is noise and leaves the claim *robust*.
 A scoring reading (another definition of the claim's test on the same runs)
 has no common statistic to pair: the claim depends on it only where the two
 give conflicting decisive verdicts (reproduced under one, not reproduced under
-the other), each of which holds its own error rate.
+the other), each of which holds its own error rate.  So does a time (a time per
+frame, frames per second): each universe's runs were timed when they ran, so a
+difference between universes mixes the reading with the machine's load at the
+two moments, and no paired effect of the reading can be read from it.
 """
 
 import math
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 
@@ -28,6 +32,30 @@ from replication.evidence.verdict import Outcome
 from replication.evidence.settings import INFERENCE
 
 DECISIVE = {Outcome.REPRODUCED, Outcome.NOT_REPRODUCED}  # two decisive verdicts conflict; one inconclusive does not
+
+
+class Pairing(Enum):
+    """What an alternative's cases are compared with."""
+
+    TWIN = "twin"  # the same universe with the choice at its default: a paired effect
+    DEFAULT = "default"  # a design without twins (Sobol points): the default case, the difference confounded
+    READINGS = "readings"  # another scoring reading of the same runs: no common statistic to pair
+    TIMES = "times"  # a time measured as each universe ran: a difference mixes the reading with the machine's load
+    VERDICTS = "verdicts"  # a statistic with no per-run values (a published cell, a ranking): verdicts alone
+
+    @property
+    def unpaired(self) -> bool:
+        """Only conflicting decisive verdicts count (no effect is estimated)."""
+        return self in UNPAIRED
+
+    @property
+    def said(self) -> str:
+        """Why no effect is shown, for a reader ("" where one is)."""
+        return UNPAIRED.get(self, "")
+
+
+UNPAIRED = {Pairing.READINGS: "another scoring reading", Pairing.TIMES: "a time: load, not the reading, may move it",
+            Pairing.VERDICTS: "no per-run statistic"}
 
 
 @dataclass(frozen=True)
@@ -41,7 +69,7 @@ class ChoiceEffect:
     adjusted: float  # Holm across the claim's alternatives
     flips: int  # cases whose verdict differs from the twin's
     compared: int  # cases compared
-    paired: str  # "twin" | "default" (a design without twins: the difference is confounded) | "readings"
+    paired: Pairing
 
     @property
     def significant(self) -> bool:
@@ -50,7 +78,7 @@ class ChoiceEffect:
     @property
     def moves(self) -> bool:
         """Whether the verdict depends on this alternative."""
-        return bool(depends(self.adjusted, self.flips > 0)) or (self.paired == "readings" and self.flips > 0)
+        return bool(depends(self.adjusted, self.flips > 0)) or (self.paired.unpaired and self.flips > 0)
 
 
 def paired_effect(alternative: dict, twin: dict) -> tuple[Estimate | None, float]:
@@ -74,8 +102,8 @@ def depends(adjusted, flipped) -> np.ndarray:
     return np.asarray(flipped) & (np.nan_to_num(np.asarray(adjusted, dtype=float), nan=1.0) < INFERENCE.alpha)
 
 
-def adjust(effects: list[tuple[str, str, Estimate | None, float, int, int, str]]) -> list[ChoiceEffect]:
-    """The alternatives' effects with Holm's correction across them (readings' rows take no part)."""
-    p = np.array([e[3] if e[6] != "readings" else math.nan for e in effects], dtype=float)
+def adjust(effects: list[tuple[str, str, Estimate | None, float, int, int, Pairing]]) -> list[ChoiceEffect]:
+    """The alternatives' effects with Holm's correction across them (unpaired rows take no part)."""
+    p = np.array([math.nan if e[6].unpaired else e[3] for e in effects], dtype=float)
     adjusted = holm(p) if len(p) else p
     return [ChoiceEffect(*e[:4], float(a), *e[4:]) for e, a in zip(effects, adjusted)]
