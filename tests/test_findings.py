@@ -71,7 +71,9 @@ def _drawn(tmp_path: Path) -> Drawn:
                                           "A,N=1,12345.6,,,3\nB,N=1,0.5,0.25,0.75,0\n")
     (folder / "exp" / "summary.json").write_text(json.dumps({"paper": "p"}))
     (folder / "status.json").write_text(json.dumps({"runs": 40, "experiments": {
-        "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0}}}))
+        "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0, "designed": 0},
+        "exp_readings": {"runs": 300, "minutes": None, "cpu_minutes": 9.5, "stale": 0, "universes": 6,
+                         "designed": 17}}}))
     return Drawn(folder)
 
 
@@ -86,7 +88,8 @@ def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path
     assert first == "reproduced: 0.1235 [0.1, 0.15]; 12,346 0.5 [0.25, 0.75] 3; 1.25"
     assert "| `p.a`: A beats B | **reproduced** | A - B | 0.1235 [0.1, 0.15] | 20 | one reading |" in tables
     assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
-    assert "| `exp` | 40 | 1.25 | 2.5 |" in tables
+    assert "| `exp` | 40 |  | 1.25 | 2.5 |" in tables
+    assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |" in tables  # a multiverse the record holds in part
 
 
 @pytest.mark.parametrize("template, named", [

@@ -84,16 +84,17 @@ def main(argv: list[str]) -> None:
     except ConfigError as error:
         fail(str(error))
     stale = {}  # drawn from the record: per experiment, its recorded runs that other code made
-    for name, page, stale_runs in drawn:
+    designed = {}  # per multiverse, its universes by design (the record may hold fewer)
+    for name, page, stale_runs, universes in drawn:
         if page is not None:
             print(f"{name}: {page}")
         if stale_runs is not None:
-            stale[name] = stale_runs
+            stale[name], designed[name] = stale_runs, universes
     reports = resolve(cfg.reports)
     if source == "record":
         held = resolve(cfg.record)
         drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", published_path(cfg.published_values)))
-        print(f"status: {write_status(reports, Manifest.read(held), stale, drawn_from)}")
+        print(f"status: {write_status(reports, Manifest.read(held), stale, designed, drawn_from)}")
     if switches["pdf"]:
         from replication.report.pdf import write_pdf
 
@@ -121,10 +122,11 @@ def main(argv: list[str]) -> None:
                 print(f"console: {line}", file=sys.stderr)
 
 
-def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[str, Path | None, int | None]:
+def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[str, Path | None, int | None, int]:
     """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``): its name, its
-    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said) and, from the
-    record, how many of its recorded runs other code made."""
+    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said), from the
+    record how many of its recorded runs other code made, and a multiverse's universes by its design (0 for
+    an experiment)."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         try:
             check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
@@ -132,7 +134,7 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
             if chosen:  # named on the command line: the user wants to know
                 raise
             print(f"skipped: {error}", file=sys.stderr)  # one broken file never breaks the others
-            return name, None, None
+            return name, None, None, 0
         cfg = compose("config", overrides=[f"experiment={name}", *overrides])
         configure(cfg.inference)
         if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
@@ -140,15 +142,17 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
             page = write_multiverse_report(cfg, multiverse, tuple(overrides),
                                            lambda name, u: record.universe(multiverse.name, u.name))
             return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
-                                   for u in multiverse.universes for e in multiverse.experiments)
+                                   for u in multiverse.universes for e in multiverse.experiments), \
+                len(multiverse.universes)
         if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
-            return name, write_multiverse_report(cfg, load_multiverse(cfg), tuple(overrides)), None
+            multiverse = load_multiverse(cfg)
+            return name, write_multiverse_report(cfg, multiverse, tuple(overrides)), None, len(multiverse.universes)
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
-            return name, write_experiment_report(cfg, results), len(store.stale(results.runs))
+            return name, write_experiment_report(cfg, results), len(store.stale(results.runs)), 0
         results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
-        return name, write_experiment_report(cfg, results), None
+        return name, write_experiment_report(cfg, results), None, 0
 
 
 def findings(argv: list[str]) -> None:

@@ -12,7 +12,8 @@ every number it quotes taken from the record's drawn pages (``<reports>/record``
 - ``table("bis_pf", "table2_error").at(method="BIS-PF", condition="scene=exp2_16_targets")``: one row of a
   table (``.ours``, ``.estimate``, any column by name: ``row["failed runs"]``), its numbers shown to 4
   significant digits; ``.rows`` every row;
-- ``experiment("bis_pf")``: its runs, minutes and CPU-minutes as recorded;
+- ``experiment("bis_pf")``: its runs, minutes and CPU-minutes as recorded (a multiverse's ``universes``
+  recorded of those ``designed``);
 - ``scorecard()``, ``cells()``, ``times()``: the paper's claims, its published cells beside ours, and its
   experiments' cost, as Markdown tables.
 
@@ -175,9 +176,13 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         return ", ".join(f"{n} {verdict}" for verdict, n in counted.items())
 
     def times() -> str:
+        def universes(e: dict) -> str:  # a multiverse's, recorded of designed (a record may hold some)
+            return f"{e['universes']} of {e['designed']}" if e.get("designed") else ""
+
         names = drawn.experiments_of(paper) if paper in papers else list(status["experiments"])
-        return markdown_table(["experiment", "runs", "minutes (2 workers)", "CPU-minutes"],
-                              [[f"`{n}`", *(experiment(n)[k] for k in ("runs", "minutes", "cpu_minutes"))]
+        return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes"],
+                              [[f"`{n}`", experiment(n)["runs"], universes(status["experiments"][n]),
+                                *(experiment(n)[k] for k in ("minutes", "cpu_minutes"))]
                                for n in names if n in status["experiments"]])
 
     return {"paper": papers.get(paper), "papers": papers, "page": paper,

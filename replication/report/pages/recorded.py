@@ -18,9 +18,11 @@ from replication.record.manifest import PAGES, RECOMPUTED, Manifest
 STATUS = "status.json"
 
 
-def write_status(out: Path, manifest: Manifest, stale: dict[str, int], drawn_from: dict[str, str]) -> Path:
+def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed: dict[str, int],
+                 drawn_from: dict[str, str]) -> Path:
     """``<out>/status.json``: the manifest's account of the runs drawn, per experiment how many of its
-    recorded runs other code or settings than this checkout's made (``stale``), and what the pages were
+    recorded runs other code or settings than this checkout's made (``stale``), per multiverse how many
+    universes its design has beside those recorded (``designed``; 0 for an experiment), and what the pages were
     drawn from (``drawn_from``: the digests of the record, the configs, the published values and the
     drawing code, so that pages drawn from other inputs are drawn again before findings are rendered)."""
     entries = {name: manifest.experiments[name] for name in stale}
@@ -33,6 +35,7 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], drawn_fro
         "first": min((e.first_computed for e in entries.values() if e.first_computed), default=None),
         "last": max((e.last_computed for e in entries.values() if e.last_computed), default=None),
         "experiments": {name: {"runs": entries[name].runs, "stale": n, "universes": entries[name].universes,
+                               "designed": designed.get(name, 0),
                                "minutes": None if entries[name].universes else _minutes(entries[name]),
                                "cpu_minutes": round(entries[name].wall_s / 60, 1)} for name, n in stale.items()},
     }
