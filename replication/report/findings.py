@@ -176,14 +176,13 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         return ", ".join(f"{n} {verdict}" for verdict, n in counted.items())
 
     def times() -> str:
-        def universes(e: dict) -> str:  # a multiverse's, recorded of designed (a record may hold some)
-            return f"{e['universes']} of {e['designed']}" if e.get("designed") else ""
-
         names = drawn.experiments_of(paper) if paper in papers else list(status["experiments"])
-        return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes"],
-                              [[f"`{n}`", experiment(n)["runs"], universes(status["experiments"][n]),
-                                *(experiment(n)[k] for k in ("minutes", "cpu_minutes"))]
-                               for n in names if n in status["experiments"]])
+        rows = []
+        for name in (n for n in names if n in status["experiments"]):
+            shown, counts = experiment(name), status["experiments"][name]
+            universes = f"{counts['universes']} of {counts['designed']}" if counts.get("designed") else ""
+            rows.append([f"`{name}`", shown["runs"], universes, shown["minutes"], shown["cpu_minutes"]])
+        return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes"], rows)
 
     return {"paper": papers.get(paper), "papers": papers, "page": paper,
             "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
