@@ -11,8 +11,8 @@ import pytest
 from replication.paths import PACKAGE_DIR
 from replication.record.manifest import MANIFEST, PAGES, sha256
 from replication.report.__main__ import findings, main as report
-from replication.report.findings import (Drawn, drawn_inputs, estimate, inputs, number, render, stale, write_html,
-                                         write_pages)
+from replication.report.findings import (README, README_MARKS, README_TEMPLATE, Drawn, drawn_inputs, duration, estimate,
+                                         inputs, number, render, stale, write_html, write_pages)
 
 ROOT = PACKAGE_DIR.parent
 FINDINGS = ROOT / "docs" / "findings"
@@ -32,25 +32,37 @@ def shipped_pages(tmp_path_factory):
 def test_the_findings_on_disk_were_rendered_from_this_record_these_templates_and_this_code():
     if not PUBLISHED.exists():
         pytest.skip("../shared/reference is not beside this clone")
-    why = stale(FINDINGS, inputs(ROOT / "record", FINDINGS / "templates", PUBLISHED))
+    why = stale(FINDINGS, inputs(ROOT / "record", FINDINGS / "templates", PUBLISHED), ROOT / "README.md")
     assert not why, f"docs/findings/ is stale ({'; '.join(why)}): run make findings"
 
 
 def test_a_changed_input_or_a_page_edited_by_hand_makes_the_findings_stale(tmp_path):
     rendered_from = {"record": "a", "templates": "b", "code": "c"}
-    write_pages({"p": "# P\n", "index": "# all\n"}, tmp_path, rendered_from)
-    assert stale(tmp_path, rendered_from) == []
-    assert stale(tmp_path, {**rendered_from, "record": "z"}) == ["the record changed since they were rendered"]
+    readme = tmp_path / "project" / "README.md"
+    readme.parent.mkdir()
+    readme.write_text(f"# R\n\n{README_MARKS[0]} by hand -->\nold\n{README_MARKS[1]}\n\nbelow\n")
+    write_pages({"p": "# P\n", "index": "# all\n", README: "12 MB\n"}, tmp_path, rendered_from, readme)
+    assert readme.read_text() == f"# R\n\n{README_MARKS[0]} by hand -->\n12 MB\n{README_MARKS[1]}\n\nbelow\n"
+    assert not (tmp_path / f"{README}.md").exists()
+    assert stale(tmp_path, rendered_from, readme) == []
+    assert stale(tmp_path, {**rendered_from, "record": "z"}, readme) == ["the record changed since they were rendered"]
     (tmp_path / "p.md").write_text("# P, better\n")
     (tmp_path / "q.md").write_text("# Q\n")
-    assert stale(tmp_path, rendered_from) == ["p.md was edited by hand", "q.md is not rendered"]
+    readme.write_text(readme.read_text().replace("12 MB", "11 MB"))  # the README's rendered part typed over
+    assert stale(tmp_path, rendered_from, readme) == [
+        "README.md's part on the record was edited by hand", "p.md was edited by hand", "q.md is not rendered"]
+    readme.write_text("# R, marks gone\n")
+    assert "README.md's part on the record was edited by hand" in stale(tmp_path, rendered_from, readme)
+    with pytest.raises(LookupError, match="README.md has no part for the record: put <!-- rendered from the record"):
+        write_pages({README: "12 MB\n"}, tmp_path, rendered_from, readme)
 
 
 @pytest.mark.slow  # draws every page of the record (about 2 minutes); the test above checks the same inputs
 def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages):
     pages = render(Drawn(shipped_pages / PAGES), FINDINGS / "templates")
     on_disk = {p.stem: p.read_text() for p in FINDINGS.glob("*.md")}  # drawn by the code and record of today
-    assert set(pages) == set(on_disk) == {"index", "ism_pf", "bis_pf", "gps_qmcpf", "fusion_pf", "hspf"}
+    on_disk[README] = (ROOT / "README.md").read_text().split(README_MARKS[0])[1].split("\n", 1)[1].split(README_MARKS[1])[0]
+    assert set(pages) == set(on_disk) == {"index", "ism_pf", "bis_pf", "gps_qmcpf", "fusion_pf", "hspf", README}
     stale = [name for name in pages if pages[name] != on_disk[name]]
     assert not stale, f"docs/findings/ differs from what the record renders for {stale}: run pf-replicate findings"
     assert (shipped_pages / PAGES / "findings" / "bis_pf.html").exists()  # and the record's pages show them
@@ -70,7 +82,7 @@ def _drawn(tmp_path: Path) -> Drawn:
     (folder / "exp" / "t.csv").write_text("method,condition,ours,ci_low,ci_high,failed runs\n"
                                           "A,N=1,12345.6,,,3\nB,N=1,0.5,0.25,0.75,0\n")
     (folder / "exp" / "summary.json").write_text(json.dumps({"paper": "p"}))
-    (folder / "status.json").write_text(json.dumps({"runs": 40, "experiments": {
+    (folder / "status.json").write_text(json.dumps({"runs": 40, "megabytes": 11.8, "experiments": {
         "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0, "designed": 0},
         "exp_readings": {"runs": 300, "minutes": None, "cpu_minutes": 9.5, "stale": 0, "universes": 6,
                          "designed": 17}}}))
@@ -90,6 +102,19 @@ def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path
     assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
     assert "| `exp` | 40 |  | 1.25 | 2.5 |" in tables
     assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |" in tables  # a multiverse the record holds in part
+
+
+def test_the_readme_part_gives_the_record_size_and_what_each_part_took(tmp_path):
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / README_TEMPLATE).write_text("{{ record.megabytes }} MB\n{{ parts() }}\n")
+    pages = render(_drawn(tmp_path), tmp_path / "t")
+    assert set(pages) == {README}  # a part, not a page of its own
+    size, *table = pages[README].splitlines()
+    assert size == "11.8 MB"
+    assert "| the 1 experiments | 40 |  | 0.04 | 1 min, measured |" in table  # 2.5 CPU-minutes
+    assert "| `exp_readings` | 300 | 6 of 17 | 0.16 | 5 min, CPU-hours / 2 |" in table
+    assert [duration(m) for m in (41.1, 89, 90, 265)] == ["41 min", "89 min", "1.5 h", "4.4 h"]
+    assert write_html(pages, tmp_path / "html") == []  # the index page says the same
 
 
 @pytest.mark.parametrize("template, named", [
@@ -144,7 +169,7 @@ def test_findings_writes_the_pages_and_draws_the_record_only_when_needed(tmp_pat
     argv = [f"record={record}", f"reports={reports}", f"findings={out}", f"published_values={tmp_path / 'none.csv'}"]
     findings(argv)
     assert (out / "p.md").read_text() == "reproduced\n" and not drew
-    assert stale(out, inputs(record, out / "templates", tmp_path / "none.csv")) == []
+    assert stale(out, inputs(record, out / "templates", tmp_path / "none.csv"), tmp_path / "README.md") == []
     (record / MANIFEST).write_text('{"changed": 1}')  # another record: its pages are drawn again first
     findings(argv)
     assert drew and "source=record" in drew[0]

@@ -44,6 +44,7 @@ from replication.runner.store import Store
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
 SCREENSHOT = "screenshot.png"
 PICTURE = "scorecard.png"  # the record's first page beside its findings (the README shows it)
+README_PATH = "README.md"  # whose part on the record (its size, what made it, what each part took) findings renders
 OPTIONS = ("sweep", "metric", "source")  # ours too: name=text
 SOURCES = ("store", "record")
 
@@ -156,8 +157,9 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
 
 
 def findings(argv: list[str]) -> None:
-    """``pf-replicate findings [record=record] [reports=reports] [findings=docs/findings]``: each paper's
-    findings rendered from the record into ``<findings>/<paper>.md`` (:mod:`replication.report.findings`), its
+    """``pf-replicate findings [record=record] [reports=reports] [findings=docs/findings] [readme=README.md]``:
+    each paper's findings rendered from the record into ``<findings>/<paper>.md``, and the README's part on
+    the record between its marks (:mod:`replication.report.findings`), the record's
     pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code;
     when drawn, their first page's picture too (``<findings>/scorecard.png``, where Chromium is installed)."""
     if {"--help", "-h"} & set(argv):
@@ -178,9 +180,10 @@ def findings(argv: list[str]) -> None:
             print(f"findings: {out / PICTURE}")
     try:
         pages = render_findings(drawn, out / "templates")
+        written = write_pages(pages, out, rendered_from, resolve(settings.get("readme", README_PATH)))
     except LookupError as error:
         fail(str(error))
-    for page in write_pages(pages, out, rendered_from):
+    for page in written:
         print(f"findings: {page}")
 
 

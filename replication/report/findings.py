@@ -17,7 +17,11 @@ every number it quotes taken from the record's drawn pages (``<reports>/record``
 - ``scorecard()``, ``cells()``, ``times()``: the paper's claims, its published cells beside ours, and its
   experiments' cost, as Markdown tables.
 
-A row a template names that the record does not hold stops the rendering with one line naming it.
+- ``parts()``: the record's parts (the experiments together, each multiverse) and what each took.
+
+The README's part on the record (its size, what made it and what each part took: ``templates/_readme.md.j2``)
+is rendered the same way between the README's :data:`README_MARKS`, the rest of the README staying as
+written.  A row a template names that the record does not hold stops the rendering with one line naming it.
 :data:`RENDERED` records what the pages were rendered from (the record, the templates, the configs, the
 published values, the code) so that a check costs no drawing: :func:`stale` says why pages no longer match
 (``tests/test_findings.py``).
@@ -41,6 +45,9 @@ from replication.report.pages.recorded import STATUS
 from replication.runner.provenance import run_code_digest
 
 RENDERED = "rendered.json"  # beside the pages: what they were rendered from, and each page's SHA-256
+README = "README"  # the name of the README's part on the record among the pages rendered
+README_TEMPLATE = "_readme.md.j2"  # its template, beside the pages'
+README_MARKS = ("<!-- rendered from the record", "<!-- end of the part rendered from the record -->")
 
 
 def number(value) -> str:
@@ -57,6 +64,11 @@ def estimate(value, low, high) -> str:
     if any(v is None or not math.isfinite(v) for v in (low, high)):
         return number(value)
     return f"{number(value)} [{number(low)}, {number(high)}]"
+
+
+def duration(minutes: float) -> str:
+    """A wall time as the findings show it: whole minutes up to an hour and a half, else hours to 0.1."""
+    return f"{minutes:.0f} min" if minutes < 90 else f"{minutes / 60:.1f} h"
 
 
 def _cell(value):
@@ -184,10 +196,21 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
             rows.append([f"`{name}`", shown["runs"], universes, shown["minutes"], shown["cpu_minutes"]])
         return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes"], rows)
 
+    def parts() -> str:
+        experiments = status["experiments"]
+        single = [e for e in experiments.values() if not e.get("designed")]
+        rows = [[f"the {len(single)} experiments", number(sum(e["runs"] for e in single)), "",
+                 number(round(sum(e["cpu_minutes"] for e in single) / 60, 2)),
+                 f"{duration(sum(e['minutes'] or 0 for e in single))}, measured"]]
+        rows += [[f"`{name}`", number(e["runs"]), f"{e['universes']} of {e['designed']}",
+                  number(round(e["cpu_minutes"] / 60, 2)), f"{duration(e['cpu_minutes'] / 2)}, CPU-hours / 2"]
+                 for name, e in experiments.items() if e.get("designed")]
+        return markdown_table(["part", "runs", "universes", "CPU-hours", "on 2 workers"], rows)
+
     return {"paper": papers.get(paper), "papers": papers, "page": paper,
             "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
             "claim": claim, "table": drawn.table, "experiment": experiment, "verdicts": verdicts,
-            "scorecard": scorecard, "cells": cells, "times": times}
+            "scorecard": scorecard, "cells": cells, "times": times, "parts": parts}
 
 
 def _float(text):
@@ -206,17 +229,20 @@ def markdown_table(header: list[str], rows: list[list]) -> str:
 
 
 def render(drawn: Drawn, templates: Path) -> dict[str, str]:
-    """Each template of ``templates`` rendered: its page's name (``bis_pf``, ``index``) -> Markdown."""
+    """Each template of ``templates`` rendered: its page's name (``bis_pf``, ``index``) -> Markdown; and the
+    README's part on the record (:data:`README_TEMPLATE`) as :data:`README`."""
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(templates), undefined=jinja2.StrictUndefined,
                              keep_trailing_newline=True, autoescape=False)
     papers = {paper.key: paper for paper in load_papers()}
+    names = {path.name: path.name.removesuffix(".md.j2") for path in sorted(Path(templates).glob("[!_]*.md.j2"))}
+    if (Path(templates) / README_TEMPLATE).exists():
+        names[README_TEMPLATE] = README
     pages = {}
-    for path in sorted(Path(templates).glob("[!_]*.md.j2")):  # _name.md.j2: a part the pages include
-        name = path.name.removesuffix(".md.j2")
+    for template, name in names.items():  # _name.md.j2: a part the pages include (or the README's)
         try:
-            pages[name] = env.get_template(path.name).render(**context(drawn, name, papers))
+            pages[name] = env.get_template(template).render(**context(drawn, name, papers))
         except (LookupError, AttributeError, jinja2.UndefinedError) as error:
-            raise LookupError(f"{path.name}: {error}") from None
+            raise LookupError(f"{template}: {error}") from None
     return pages
 
 
@@ -242,30 +268,66 @@ def _files(folder: Path, pattern: str) -> str:
     return digest.hexdigest()
 
 
-def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str]) -> list[Path]:
-    """The pages as ``<out>/<name>.md``, and :data:`RENDERED`: their inputs and each page's SHA-256."""
+def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str], readme: Path) -> list[Path]:
+    """The pages as ``<out>/<name>.md``, the :data:`README` part into ``readme`` (:func:`embed`), and
+    :data:`RENDERED`: their inputs and each page's SHA-256."""
     written = []
     for name, text in pages.items():
-        written.append(out / f"{name}.md")
-        written[-1].write_text(text)
-    digests = {name: hashlib.sha256(text.encode()).hexdigest() for name, text in pages.items()}
+        written.append(embed(readme, text) if name == README else out / f"{name}.md")
+        if name != README:
+            written[-1].write_text(text)
+    digests = {name: _digest(text) for name, text in pages.items()}
     (out / RENDERED).write_text(json.dumps({"inputs": rendered_from, "pages": digests}, indent=1) + "\n")
     return written
 
 
-def stale(out: Path, rendered_from: dict[str, str]) -> list[str]:
-    """Why the pages in ``out`` are not what the record renders today: an input changed since they were
-    rendered (the record, the templates, the code), or a page was edited, added or removed by hand."""
+def stale(out: Path, rendered_from: dict[str, str], readme: Path) -> list[str]:
+    """Why the pages in ``out`` (and ``readme``'s part) are not what the record renders today: an input
+    changed since they were rendered (the record, the templates, the code), or a page was edited, added or
+    removed by hand."""
     if not (out / RENDERED).exists():
         return [f"{out / RENDERED} is missing"]
     written = json.loads((out / RENDERED).read_text())
     reasons = [f"the {name} changed since they were rendered" for name, digest in rendered_from.items()
                if written["inputs"].get(name) != digest]
-    on_disk = {p.stem: hashlib.sha256(p.read_bytes()).hexdigest() for p in out.glob("*.md")}
-    reasons += [f"{name}.md was edited by hand" for name in on_disk.keys() & written["pages"].keys()
+    on_disk = {p.stem: _digest(p.read_text()) for p in out.glob("*.md")}
+    if README in written["pages"]:
+        on_disk[README] = _digest(_split(readme)[1]) if _marked(readme) else "no part"
+    reasons += [f"{_shown(name, readme)} was edited by hand" for name in sorted(on_disk.keys() & written["pages"].keys())
                 if on_disk[name] != written["pages"][name]]
-    reasons += [f"{name}.md is not rendered" for name in on_disk.keys() ^ written["pages"].keys()]
+    reasons += [f"{_shown(name, readme)} is not rendered" for name in sorted(on_disk.keys() ^ written["pages"].keys())]
     return reasons
+
+
+def embed(readme: Path, text: str) -> Path:
+    """``readme`` with ``text`` between its :data:`README_MARKS` (the rest stays as written by hand)."""
+    head, _, tail = _split(readme)
+    readme.write_text(head + text + tail)
+    return readme
+
+
+def _split(readme: Path) -> tuple[str, str, str]:
+    """``readme`` as (up to its first mark and that mark's line, between the marks, from its second mark)."""
+    text = readme.read_text()
+    if not _marked(readme):
+        raise LookupError(f"{readme} has no part for the record: put {' and '.join(README_MARKS)} in it")
+    head, rest = text.split(README_MARKS[0], 1)
+    line, rest = rest.split("\n", 1)
+    body, tail = rest.split(README_MARKS[1], 1)
+    return head + README_MARKS[0] + line + "\n", body, README_MARKS[1] + tail
+
+
+def _marked(readme: Path) -> bool:
+    text = readme.read_text() if readme.exists() else ""
+    return README_MARKS[0] in text and README_MARKS[1] in text.split(README_MARKS[0], 1)[1]
+
+
+def _shown(name: str, readme: Path) -> str:
+    return f"{readme.name}'s part on the record" if name == README else f"{name}.md"
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def write_html(pages: dict[str, str], out: Path) -> list[Path]:
@@ -280,6 +342,8 @@ def write_html(pages: dict[str, str], out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, text in pages.items():
+        if name == README:  # the README's part: the index page says the same
+            continue
         body = re.sub(r'href="([\w-]+)\.md"', r'href="\1.html"', markdown.render(text))
         title = next((line[2:] for line in text.splitlines() if line.startswith("# ")), name)
         path = out / f"{name}.html"

@@ -20,7 +20,8 @@ STATUS = "status.json"
 
 def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed: dict[str, int],
                  drawn_from: dict[str, str]) -> Path:
-    """``<out>/status.json``: the manifest's account of the runs drawn, per experiment how many of its
+    """``<out>/status.json``: the manifest's account of the runs drawn (their count, CPU time, commits,
+    dates, the size of their files, the machines and libraries that made them), per experiment how many of its
     recorded runs other code or settings than this checkout's made (``stale``), per multiverse how many
     universes its design has beside those recorded (``designed``; 0 for an experiment), and what the pages were
     drawn from (``drawn_from``: the digests of the record, the configs, the published values and the
@@ -32,6 +33,9 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
         "failed": sum(e.failed for e in entries.values()),
         "cpu_hours": round(sum(e.wall_s for e in entries.values()) / 3600, 1),
         "commits": sorted({c[:7] for e in entries.values() for c in e.commits}),
+        "megabytes": round(sum(e.bytes for e in entries.values()) / 1e6, 1),
+        "machines": sorted({m for e in entries.values() for m in e.machines}),
+        "libraries": sorted({lib for e in entries.values() for lib in e.libraries}),
         "first": min((e.first_computed for e in entries.values() if e.first_computed), default=None),
         "last": max((e.last_computed for e in entries.values() if e.last_computed), default=None),
         "experiments": {name: {"runs": entries[name].runs, "stale": n, "universes": entries[name].universes,
