@@ -17,6 +17,8 @@ from pathlib import Path
 
 import pytest
 
+from replication.report.findings import README_MARKS
+
 ROOT = Path(__file__).resolve().parents[1]
 PUBLISHED = ROOT.parent / "shared" / "reference" / "published_values.csv"
 TUTORIALS = {"tutorial_state_space.md", "tutorial_video.md"}
@@ -47,7 +49,9 @@ def hand_written() -> list[Path]:
 
 
 def prose(text: str) -> str:
-    """``text`` without its fenced code blocks (commands and their settings) and its link targets."""
+    """``text`` without its fenced code blocks (commands and their settings), its link targets and its part
+    rendered from the record (between :data:`~replication.report.findings.README_MARKS`)."""
+    text = re.sub(re.escape(README_MARKS[0]) + ".*?" + re.escape(README_MARKS[1]), "", text, flags=re.S)
     text = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)
     return re.sub(r"\]\([^)]*\)", "]", text)
 
@@ -80,8 +84,9 @@ def test_the_result_rule_finds_typed_results_and_spares_the_rest():
     text = ("BIS-PF errs by 24.6 px, 31 % of frames, in 7 min; F is about 1e-86.  The paper's 5.52 fps.\n"
             "A 95% interval, 16 universes, 20 px, N = 100, sigma = 0.1, section 1.2.\n"
             "```sh\nmake verify N=200 sigma=0.05\n```\n"
-            "[a link](docs/x-1.5.md) in Python 3.11.\n")
-    assert typed_results(text, {"5.52"}) == ["24.6", "31 %", "7 min", "1e-86"]
+            "[a link](docs/x-1.5.md) in Python 3.11.\n"
+            f"{README_MARKS[0]} by findings -->\nThe record is 14.5 MB.\n{README_MARKS[1]} But 2.5 h by hand.\n")
+    assert typed_results(text, {"5.52"}) == ["24.6", "31 %", "7 min", "1e-86", "2.5 h"]
 
 
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")

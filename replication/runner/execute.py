@@ -34,7 +34,7 @@ import replication
 from replication.errors import RunFailed
 from replication.run import Run
 from replication.runner.failures import failure
-from replication.runner.lifeline import watch_parent
+from replication.runner.lifeline import start_worker
 from replication.runner.memory import one_blas_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
@@ -156,14 +156,6 @@ def _answers(address: str, seconds: float = 10.0) -> None:
     host, _, port = address.removeprefix("ray://").rpartition(":")
     if host and port.isdigit():
         socket.create_connection((host, int(port)), timeout=seconds).close()
-
-
-def start_worker(runner: int) -> None:
-    """A loky worker's initializer.  It ignores SIGINT: a terminal's Ctrl-C reaches the whole process
-    group, and a worker caught waiting for its next run would print a traceback; the parent stops the
-    workers.  And it exits as soon as ``runner`` (the process that started it) is gone."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    watch_parent(runner)
 
 
 @contextmanager

@@ -3,7 +3,7 @@
 A child process holds a *lifeline* (:func:`watch_parent`): a daemon thread that ends the process
 (``os._exit``) within :data:`POLL_S` of its parent's death, however the parent died (``kill -9``
 included) and whether the child is computing or waiting.  The loky workers get it through their
-initializer (:func:`replication.runner.execute.parallel_backend`), and their resource trackers exit
+initializer (:func:`start_worker`), and their resource trackers exit
 once no worker holds their pipe; a companion experiment (``also:``) gets it from the environment
 its runner starts it with (:func:`child_environment`, :func:`watch_parent_from_environment`).  The
 dask backend's local workers die with their parent already (distributed watches it); ray's
@@ -32,6 +32,17 @@ def watch_parent(parent: int) -> None:
         os._exit(1)  # no clean-up: the parent that would read the results is gone
 
     threading.Thread(target=watch, name="lifeline", daemon=True).start()
+
+
+def start_worker(runner: int) -> None:
+    """A loky worker's initializer.  It ignores SIGINT: a terminal's Ctrl-C reaches the whole process
+    group, and a worker caught waiting for its next run would print a traceback; the parent stops the
+    workers.  And it exits as soon as ``runner`` (the process that started it) is gone.  It lives here,
+    in a module that imports nothing heavy, because the worker imports the initializer's module before
+    calling it: from the runner's module that would import the tasks and compile their numba kernels
+    with SIGINT not yet ignored, and a Ctrl-C landing inside numba's compiler is printed, not raised."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    watch_parent(runner)
 
 
 def child_environment() -> dict[str, str]:
