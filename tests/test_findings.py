@@ -12,7 +12,8 @@ from replication.paths import PACKAGE_DIR
 from replication.record.manifest import MANIFEST, PAGES, sha256
 from replication.report.__main__ import findings, main as report
 from replication.report.findings import (README, README_MARKS, README_TEMPLATE, Drawn, drawn_inputs, duration, estimate,
-                                         inputs, number, render, stale, write_html, write_pages)
+                                         inputs, number, readme_part, render, stale, write_html,
+                                         write_pages)
 
 ROOT = PACKAGE_DIR.parent
 FINDINGS = ROOT / "docs" / "findings"
@@ -61,7 +62,7 @@ def test_a_changed_input_or_a_page_edited_by_hand_makes_the_findings_stale(tmp_p
 def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages):
     pages = render(Drawn(shipped_pages / PAGES), FINDINGS / "templates")
     on_disk = {p.stem: p.read_text() for p in FINDINGS.glob("*.md")}  # drawn by the code and record of today
-    on_disk[README] = (ROOT / "README.md").read_text().split(README_MARKS[0])[1].split("\n", 1)[1].split(README_MARKS[1])[0]
+    on_disk[README] = readme_part(ROOT / "README.md")
     assert set(pages) == set(on_disk) == {"index", "ism_pf", "bis_pf", "gps_qmcpf", "fusion_pf", "hspf", README}
     stale = [name for name in pages if pages[name] != on_disk[name]]
     assert not stale, f"docs/findings/ differs from what the record renders for {stale}: run pf-replicate findings"

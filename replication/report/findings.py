@@ -273,8 +273,10 @@ def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str],
     :data:`RENDERED`: their inputs and each page's SHA-256."""
     written = []
     for name, text in pages.items():
-        written.append(embed(readme, text) if name == README else out / f"{name}.md")
-        if name != README:
+        if name == README:
+            written.append(embed(readme, text))
+        else:
+            written.append(out / f"{name}.md")
             written[-1].write_text(text)
     digests = {name: _digest(text) for name, text in pages.items()}
     (out / RENDERED).write_text(json.dumps({"inputs": rendered_from, "pages": digests}, indent=1) + "\n")
@@ -292,7 +294,8 @@ def stale(out: Path, rendered_from: dict[str, str], readme: Path) -> list[str]:
                if written["inputs"].get(name) != digest]
     on_disk = {p.stem: _digest(p.read_text()) for p in out.glob("*.md")}
     if README in written["pages"]:
-        on_disk[README] = _digest(_split(readme)[1]) if _marked(readme) else "no part"
+        part = readme_part(readme)
+        on_disk[README] = _digest(part) if part is not None else "no part"
     reasons += [f"{_shown(name, readme)} was edited by hand" for name in sorted(on_disk.keys() & written["pages"].keys())
                 if on_disk[name] != written["pages"][name]]
     reasons += [f"{_shown(name, readme)} is not rendered" for name in sorted(on_disk.keys() ^ written["pages"].keys())]
@@ -301,25 +304,29 @@ def stale(out: Path, rendered_from: dict[str, str], readme: Path) -> list[str]:
 
 def embed(readme: Path, text: str) -> Path:
     """``readme`` with ``text`` between its :data:`README_MARKS` (the rest stays as written by hand)."""
-    head, _, tail = _split(readme)
-    readme.write_text(head + text + tail)
+    parts = _parts(readme)
+    if parts is None:
+        raise LookupError(f"{readme} has no part for the record: put {' and '.join(README_MARKS)} in it")
+    readme.write_text(parts[0] + text + parts[2])
     return readme
 
 
-def _split(readme: Path) -> tuple[str, str, str]:
-    """``readme`` as (up to its first mark and that mark's line, between the marks, from its second mark)."""
-    text = readme.read_text()
-    if not _marked(readme):
-        raise LookupError(f"{readme} has no part for the record: put {' and '.join(README_MARKS)} in it")
-    head, rest = text.split(README_MARKS[0], 1)
-    line, rest = rest.split("\n", 1)
-    body, tail = rest.split(README_MARKS[1], 1)
-    return head + README_MARKS[0] + line + "\n", body, README_MARKS[1] + tail
+def readme_part(readme: Path) -> str | None:
+    """The text between ``readme``'s :data:`README_MARKS` (None where it has no such part)."""
+    parts = _parts(readme)
+    return parts[1] if parts else None
 
 
-def _marked(readme: Path) -> bool:
+def _parts(readme: Path) -> tuple[str, str, str] | None:
+    """``readme`` as (up to its first mark and that mark's line, between the marks, from its second mark);
+    None where it lacks either mark."""
     text = readme.read_text() if readme.exists() else ""
-    return README_MARKS[0] in text and README_MARKS[1] in text.split(README_MARKS[0], 1)[1]
+    head, first, rest = text.partition(README_MARKS[0])
+    line, _, rest = rest.partition("\n")
+    body, second, tail = rest.partition(README_MARKS[1])
+    if not (first and second):
+        return None
+    return head + first + line + "\n", body, second + tail
 
 
 def _shown(name: str, readme: Path) -> str:
