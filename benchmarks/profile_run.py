@@ -6,6 +6,9 @@ the run that the project's modules, numpy, pandas, scipy and OpenCV take.  Nothi
 profiler's overhead is mostly per Python call, so shares of code that makes many small calls read high.
 
     python benchmarks/profile_run.py bis_pf_cost MFMC N=800 --scale paper
+
+It also prints the run's time by part (:func:`staged`: drawing or reading the frames, the likelihood, the
+filter, scoring, the rest), which ``make benchmark`` records for the record's slowest experiments.
 """
 
 import argparse
@@ -19,9 +22,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from hydra import compose, initialize_config_dir  # noqa: E402
 
-from replication.paths import CONF_DIR  # noqa: E402
+from replication.paths import CONF_DIR, PACKAGE_DIR  # noqa: E402
 from replication.runner.config import expand  # noqa: E402
 from replication.runner.execute import perform  # noqa: E402
+
+# the parts of a run, by the project's subpackage (or module) whose function spent the time
+STAGES = {"scenes": "frames", "vision": "likelihood", "filters": "filter", "smc": "filter", "models": "filter",
+          "qmc.py": "filter", "metrics": "scoring"}
+REST = "rest"  # the task's set-up, the runner, and time no project function called
 
 PARTS = {"replication/": "replication", "numpy": "numpy", "pandas/": "pandas", "scipy/": "scipy",
          "numba/": "numba", "llvmlite/": "numba", "cv2": "OpenCV", "trackeval/": "TrackEval"}
@@ -58,6 +66,47 @@ def _profile(run) -> cProfile.Profile:
     return profile
 
 
+def stage(filename: str) -> str | None:
+    """The part of a run (:data:`STAGES`, else :data:`REST`) a project file's functions do; None for a
+    library's or the interpreter's."""
+    path = Path(filename)
+    if not path.is_absolute() or not path.is_relative_to(PACKAGE_DIR):
+        return None
+    return STAGES.get(path.relative_to(PACKAGE_DIR).parts[0], REST)
+
+
+def staged(stats: pstats.Stats) -> Counter:
+    """Seconds per part of the run (:func:`stage`): a project function's own time goes to its part; a
+    library's (numpy, OpenCV, built-ins) to its callers' parts, in proportion to the time it spent for each
+    (followed up through library callers to the project's)."""
+    entries = stats.stats
+    shares: dict = {}
+
+    def share(function) -> dict:
+        if function in shares:
+            return shares[function]
+        own = stage(function[0])
+        if own is not None:
+            shares[function] = {own: 1.0}
+            return shares[function]
+        shares[function] = {REST: 1.0}  # while its callers are followed: a cycle ends here
+        callers = entries[function][4] if function in entries else {}
+        spent = sum(edge[2] for edge in callers.values())
+        if spent > 0:
+            found = Counter()
+            for caller, edge in callers.items():
+                for part, fraction in share(caller).items():
+                    found[part] += fraction * edge[2] / spent
+            shares[function] = dict(found)
+        return shares[function]
+
+    seconds = Counter()
+    for function, (_, _, own_time, _, _) in entries.items():
+        for part, fraction in share(function).items():
+            seconds[part] += own_time * fraction
+    return seconds
+
+
 def runs_of(experiment: str, scale: str) -> list:
     """The runs ``experiment`` expands to at ``scale``."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
@@ -80,6 +129,7 @@ def main() -> None:
     total, shares, stats = profiled(runs[0])
     print(f"{runs[0].run_id}: {total:.1f} s under the profiler")
     print("  " + ", ".join(f"{name} {seconds / total:.0%}" for name, seconds in shares.most_common()))
+    print("  by part: " + ", ".join(f"{name} {seconds / total:.0%}" for name, seconds in staged(stats).most_common()))
     stats.sort_stats("tottime").print_stats(args.top)
 
 

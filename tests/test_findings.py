@@ -83,10 +83,16 @@ def _drawn(tmp_path: Path) -> Drawn:
     (folder / "exp" / "t.csv").write_text("method,condition,ours,ci_low,ci_high,failed runs\n"
                                           "A,N=1,12345.6,,,3\nB,N=1,0.5,0.25,0.75,0\n")
     (folder / "exp" / "summary.json").write_text(json.dumps({"paper": "p"}))
+    methods = [{"experiment": "exp", "method": "A", "cpu_minutes": 1.5, "parts": {"frames": 0.2, "filter": 0.8}},
+               {"experiment": "exp", "method": "B", "cpu_minutes": 0.5, "parts": {"frames": 0.6, "likelihood": 0.4}},
+               {"experiment": "exp", "method": "C", "cpu_minutes": 0.5, "parts": {}}]  # C: made by older code
     (folder / "status.json").write_text(json.dumps({"runs": 40, "megabytes": 11.8, "experiments": {
-        "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0, "designed": 0},
+        "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0, "designed": 0,
+                "before": {"minutes": 2.0, "cpu_minutes": 4.0, "commits": ["abc1234"], "written": "2026-11-01"}},
         "exp_readings": {"runs": 300, "minutes": None, "cpu_minutes": 9.5, "stale": 0, "universes": 6,
-                         "designed": 17}}}))
+                         "designed": 17, "before": None}},
+        "profile": {"made": {"git_commit": "abcdef123456", "machine": "x86_64 CPU"},
+                    "stages": ["frames", "likelihood", "filter", "scoring", "rest"], "methods": methods}}))
     return Drawn(folder)
 
 
@@ -101,19 +107,27 @@ def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path
     assert first == "reproduced: 0.1235 [0.1, 0.15]; 12,346 0.5 [0.25, 0.75] 3; 1.25"
     assert "| `p.a`: A beats B | **reproduced** | A - B | 0.1235 [0.1, 0.15] | 20 | one reading |" in tables
     assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
-    assert "| `exp` | 40 |  | 1.25 | 2.5 |" in tables
-    assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |" in tables  # a multiverse the record holds in part
+    assert "| `exp` | 40 |  | 1.25 | 2.5 | 2 min, 4 CPU-min (abc1234) |" in tables  # recorded again: what it took
+    assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |  |" in tables  # a multiverse the record holds in part
 
 
 def test_the_readme_part_gives_the_record_size_and_what_each_part_took(tmp_path):
     (tmp_path / "t").mkdir()
-    (tmp_path / "t" / README_TEMPLATE).write_text("{{ record.megabytes }} MB\n{{ parts() }}\n")
+    (tmp_path / "t" / README_TEMPLATE).write_text("{{ record.megabytes }} MB\n{{ parts() }}\n{{ profiled.git_commit }} "
+                                                  "{{ profiled_experiments }}\n{{ where_time_goes(false) }}\n"
+                                                  "{{ where_time_goes(true) }}\n")
     pages = render(_drawn(tmp_path), tmp_path / "t")
     assert set(pages) == {README}  # a part, not a page of its own
     size, *table = pages[README].splitlines()
     assert size == "11.8 MB"
-    assert "| the 1 experiments | 40 |  | 0.04 | 1 min, measured |" in table  # 2.5 CPU-minutes
-    assert "| `exp_readings` | 300 | 6 of 17 | 0.16 | 5 min, CPU-hours / 2 |" in table
+    assert "| the 1 experiments | 40 |  | 0.04 | 1 min, measured | 2 min, measured |" in table  # 2.5 CPU-minutes
+    assert "| `exp_readings` | 300 | 6 of 17 | 0.16 | 5 min, CPU-hours / 2 |  |" in table
+    assert "abcdef123456 1" in table
+    # the methods' parts weighted by their CPU (1.5 and 0.5 minutes; C, not profiled, left out): frames
+    # (1.5 x 0.2 + 0.5 x 0.6) / 2 = 30 %, the likelihood 0.5 x 0.4 / 2 = 10 %, the filter 1.5 x 0.8 / 2 = 60 %
+    assert "| experiment | CPU-minutes profiled | frames % | likelihood % | filter % |" in table
+    assert "| `exp` | 2 | 30 | 10 | 60 |" in table
+    assert "| `exp` | A | 1.5 | 20 |  | 80 |" in table and "| `exp` | B | 0.5 | 60 | 40 |  |" in table
     assert [duration(m) for m in (41.1, 89, 90, 265)] == ["41 min", "89 min", "1.5 h", "4.4 h"]
     assert write_html(pages, tmp_path / "html") == []  # the index page says the same
 

@@ -20,7 +20,7 @@ from replication.errors import ConfigError
 from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.published import load_published
 from replication.evidence.tables import TableKind
-from replication.record.manifest import Manifest
+from replication.record.manifest import Before, Manifest
 from replication.record.runs import RUNS_FILE, Record, read_rows
 from replication.record.verify import compare, recomputed, same_value, sample, verify
 from replication.record.write import kept_series, write, write_experiment
@@ -74,6 +74,21 @@ def test_the_manifest_names_a_damaged_file_and_keeps_an_unchanged_entry(make_cfg
     path = record / "gps_qmcpf" / RUNS_FILE
     path.write_bytes(path.read_bytes()[:-1] + b"x")
     assert manifest.damaged(record) == ["gps_qmcpf/runs.parquet"]
+
+
+def test_an_entry_recorded_again_keeps_what_its_previous_recording_took(make_cfg, tmp_path):
+    cfg, _, _ = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    record = tmp_path / "record"
+    entry = write([cfg], tmp_path / "experiments", record).experiments["gps_qmcpf"]
+    assert entry.before is None and entry.minutes is not None and entry.minutes >= 0
+    older = dataclasses.replace(entry, files={"gps_qmcpf/runs.parquet": "0" * 64}, commits=("a" * 40,), wall_s=90.0,
+                                first_computed="2026-01-01T10:00:00+00:00", last_computed="2026-01-01T10:01:30+00:00")
+    again = Manifest({"gps_qmcpf": older}).with_entry("gps_qmcpf", entry)
+    assert again.experiments["gps_qmcpf"].before == Before(("a" * 40,), older.code_digests, older.runs, 90.0, 1.5,
+                                                           older.written)
+    again.write(record)
+    assert Manifest.read(record) == again  # the previous recording reads back as written
+    assert dataclasses.replace(entry, universes=3).minutes is None  # a multiverse's universes: no span
 
 
 def test_failed_runs_are_recorded_with_their_reason_and_a_missing_run_stops_the_writer(make_cfg, tmp_path):

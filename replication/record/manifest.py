@@ -3,7 +3,8 @@
 One :class:`Entry` per experiment, read off its runs' own provenance: how many runs (and failed), the
 commits and code digests that computed them, the libraries and CPU, when the first and last were
 computed and their summed wall time; and of its files, the SHA-256 of each and their size
-(:meth:`Manifest.damaged` names a file that no longer matches).
+(:meth:`Manifest.damaged` names a file that no longer matches).  An entry that replaces another keeps
+what the one it replaced took (:class:`Before`), so that a change of code shows its cost beside the old.
 """
 
 import datetime
@@ -13,9 +14,23 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 MANIFEST = "manifest.json"
+PROFILE = "profile.json"  # where the time of the record's slowest experiments goes (benchmarks/profile_run.py)
 PAGES = "record"  # <reports>/record/: the record's pages (pf-replicate report source=record)
 RECOMPUTED = "recomputed.json"  # in <reports>/record/: the store's runs that are recorded ones, compared (verify)
 LIBRARIES = ("python_version", "numpy_version", "scipy_version", "opencv_version", "numba_version")
+
+
+@dataclass(frozen=True)
+class Before:
+    """What an experiment's previous recording took: its commits and code, runs, summed wall time and
+    minutes from its first run to its last (None for a multiverse), and when it was written."""
+
+    commits: tuple[str, ...]
+    code_digests: tuple[str, ...]
+    runs: int
+    wall_s: float
+    minutes: float | None
+    written: str
 
 
 @dataclass(frozen=True)
@@ -34,6 +49,22 @@ class Entry:
     machines: tuple[str, ...]
     written: str  # the date the file was written
     universes: int = 0  # a multiverse's universes recorded (0: an experiment)
+    before: Before | None = None  # the recording this entry replaced
+
+    @property
+    def minutes(self) -> float | None:
+        """Minutes between the completion of the first and last runs: the experiment's wall time on the
+        machine that made it, less its first run (runs in parallel; None without times).  None for a
+        multiverse, whose universes reuse runs its experiments made at other times."""
+        if self.universes or self.first_computed is None:
+            return None
+        first, last = (datetime.datetime.fromisoformat(t) for t in (self.first_computed, self.last_computed))
+        return round((last - first).total_seconds() / 60, 1)
+
+    def replacing(self, earlier: "Entry") -> "Entry":
+        """This entry, keeping what ``earlier`` (the recording it replaces) took."""
+        return replace(self, before=Before(earlier.commits, earlier.code_digests, earlier.runs, earlier.wall_s,
+                                           earlier.minutes, earlier.written))
 
     @classmethod
     def of(cls, paths: list[Path], record: Path, rows: list[dict], universes: int = 0) -> "Entry":
@@ -65,17 +96,18 @@ class Manifest:
         if not path.exists():
             return cls({})
         data = json.loads(path.read_text())
-        entries = {name: Entry(**{k: tuple(v) if isinstance(v, list) else v for k, v in entry.items()})
-                   for name, entry in data["experiments"].items()}  # JSON's lists back to the tuples written
+        entries = {name: Entry(**{**_tuples(entry), "before": entry.get("before") and Before(**_tuples(entry["before"]))})
+                   for name, entry in data["experiments"].items()}
         return cls(entries, data["scale"])
 
     def with_entry(self, name: str, entry: Entry) -> "Manifest":
-        """The manifest with ``entry`` for ``name``, unless its file is the same bytes as before (the
-        earlier entry, and its date, stay)."""
-        before = self.experiments.get(name)
-        if before is not None and before.files == entry.files:
+        """The manifest with ``entry`` for ``name``, keeping what the entry it replaces took; unless its file
+        is the same bytes as before (the earlier entry, and its date, stay)."""
+        earlier = self.experiments.get(name)
+        if earlier is not None and earlier.files == entry.files:
             return self
-        return replace(self, experiments={**self.experiments, name: entry})
+        return replace(self, experiments={**self.experiments,
+                                          name: entry if earlier is None else entry.replacing(earlier)})
 
     def write(self, record: Path) -> Path:
         path = Path(record) / MANIFEST
@@ -90,8 +122,19 @@ class Manifest:
                 if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
 
 
+def read_profile(record: Path) -> dict | None:
+    """The record's :data:`PROFILE` (None where none was made): where its slowest experiments' time goes."""
+    path = Path(record) / PROFILE
+    return json.loads(path.read_text()) if path.exists() else None
+
+
 def sha256(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _tuples(data: dict) -> dict:
+    """JSON's lists back to the tuples written."""
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
 
 
 def _distinct(rows: list[dict], key: str) -> tuple:

@@ -27,7 +27,7 @@ from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
-from replication.record.manifest import MANIFEST, PAGES, Manifest
+from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
 from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
@@ -95,7 +95,7 @@ def main(argv: list[str]) -> None:
     if source == "record":
         held = resolve(cfg.record)
         drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", published_path(cfg.published_values)))
-        print(f"status: {write_status(reports, Manifest.read(held), stale, designed, drawn_from)}")
+        print(f"status: {write_status(reports, Manifest.read(held), stale, designed, drawn_from, read_profile(held))}")
     if switches["pdf"]:
         from replication.report.pdf import write_pdf
 

@@ -18,6 +18,9 @@ every number it quotes taken from the record's drawn pages (``<reports>/record``
   experiments' cost, as Markdown tables.
 
 - ``parts()``: the record's parts (the experiments together, each multiverse) and what each took.
+- ``where_time_goes(by_method)``: the record's profile (``record/profile.json``, made by ``make benchmark``)
+  of its slowest experiments as a Markdown table, a row per experiment (its methods' parts weighted by
+  their CPU) or per method; ``profiled``: what made it (commit, machine), ``profiled_experiments``: how many.
 
 The README's part on the record (its size, what made it and what each part took: ``templates/_readme.md.j2``)
 is rendered the same way between the README's :data:`README_MARKS`, the rest of the README staying as
@@ -40,7 +43,7 @@ import pandas as pd
 from replication.evidence.claims import Paper, load_papers
 from replication.evidence.summary import load_summaries
 from replication.paths import CONF_DIR
-from replication.record.manifest import MANIFEST, sha256
+from replication.record.manifest import MANIFEST, PROFILE, sha256
 from replication.report.pages.recorded import STATUS
 from replication.runner.provenance import run_code_digest
 
@@ -164,7 +167,7 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     def experiment(name: str) -> dict:
         if name not in status["experiments"]:
             raise LookupError(f"the record holds no experiment {name!r}")
-        return {k: number(v) for k, v in status["experiments"][name].items()}
+        return {k: v if isinstance(v, dict) else number(v) for k, v in status["experiments"][name].items()}
 
     def scorecard() -> str:
         rows = claims[claims["paper"] == paper]
@@ -193,24 +196,59 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         for name in (n for n in names if n in status["experiments"]):
             shown, counts = experiment(name), status["experiments"][name]
             universes = f"{counts['universes']} of {counts['designed']}" if counts.get("designed") else ""
-            rows.append([f"`{name}`", shown["runs"], universes, shown["minutes"], shown["cpu_minutes"]])
-        return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes"], rows)
+            rows.append([f"`{name}`", shown["runs"], universes, shown["minutes"], shown["cpu_minutes"],
+                         _previous(counts.get("before"))])
+        return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes",
+                               "its previous recording"], rows)
 
     def parts() -> str:
         experiments = status["experiments"]
         single = [e for e in experiments.values() if not e.get("designed")]
+        was = [e.get("before") or e for e in single]  # an experiment recorded once took what it takes
         rows = [[f"the {len(single)} experiments", number(sum(e["runs"] for e in single)), "",
                  number(round(sum(e["cpu_minutes"] for e in single) / 60, 2)),
-                 f"{duration(sum(e['minutes'] or 0 for e in single))}, measured"]]
+                 f"{duration(sum(e['minutes'] or 0 for e in single))}, measured",
+                 f"{duration(sum(e['minutes'] or 0 for e in was))}, measured" if was != single else ""]]
         rows += [[f"`{name}`", number(e["runs"]), f"{e['universes']} of {e['designed']}",
-                  number(round(e["cpu_minutes"] / 60, 2)), f"{duration(e['cpu_minutes'] / 2)}, CPU-hours / 2"]
+                  number(round(e["cpu_minutes"] / 60, 2)), f"{duration(e['cpu_minutes'] / 2)}, CPU-hours / 2",
+                  f"{duration(e['before']['cpu_minutes'] / 2)}, CPU-hours / 2" if e.get("before") else ""]
                  for name, e in experiments.items() if e.get("designed")]
-        return markdown_table(["part", "runs", "universes", "CPU-hours", "on 2 workers"], rows)
+        return markdown_table(["part", "runs", "universes", "CPU-hours", "on 2 workers", "before"], rows)
 
+    def where_time_goes(by_method: bool) -> str:
+        profile = status.get("profile")
+        if not profile:
+            raise LookupError("the record has no profile (make benchmark writes record/profile.json)")
+        methods = pd.DataFrame([{"experiment": m["experiment"], "method": m["method"], "cpu": m["cpu_minutes"],
+                                 **m["parts"]} for m in profile["methods"] if m["parts"]])
+        stages = [s for s in profile["stages"] if s in methods]
+        if by_method:
+            rows = methods
+        else:  # each method's split weighted by its CPU
+            weighted = methods[stages].mul(methods["cpu"], axis=0).groupby(methods["experiment"], sort=False).sum()
+            cpu = methods.groupby("experiment", sort=False)["cpu"].sum()
+            rows = weighted.div(cpu, axis=0).assign(cpu=cpu).reset_index()
+        return markdown_table(["experiment", *(["method"] if by_method else []), "CPU-minutes profiled",
+                               *(f"{s} %" for s in stages)],
+                              [[f"`{r['experiment']}`", *([r["method"]] if by_method else []), number(r["cpu"]),
+                                *(number(round(100 * r[s], 1)) for s in stages)] for _, r in rows.iterrows()])
+
+    profile = status.get("profile") or {}
     return {"paper": papers.get(paper), "papers": papers, "page": paper,
             "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
             "claim": claim, "table": drawn.table, "experiment": experiment, "verdicts": verdicts,
-            "scorecard": scorecard, "cells": cells, "times": times, "parts": parts}
+            "scorecard": scorecard, "cells": cells, "times": times, "parts": parts,
+            "where_time_goes": where_time_goes, "profiled": profile.get("made"),
+            "profiled_experiments": len({m["experiment"] for m in profile.get("methods", [])})}
+
+
+def _previous(before: dict | None) -> str:
+    """What an experiment's previous recording took, as a cell: its minutes (an experiment's), CPU-minutes
+    and commits; '' where it was recorded once."""
+    if not before:
+        return ""
+    minutes = f"{number(before['minutes'])} min, " if before["minutes"] is not None else ""
+    return f"{minutes}{number(before['cpu_minutes'])} CPU-min ({', '.join(before['commits'])})"
 
 
 def _float(text):
@@ -248,10 +286,11 @@ def render(drawn: Drawn, templates: Path) -> dict[str, str]:
 
 def inputs(record: Path, templates: Path, published: Path) -> dict[str, str]:
     """What the pages are rendered from, each as a digest: the record (its manifest's SHA-256, which holds
-    every file's), the templates, the configs (the claims' words, the experiments' methods and tables), the
+    every file's, and its profile's), the templates, the configs (the claims' words, the experiments' methods and tables), the
     papers' published values, and the code that draws the record's pages and renders them (every module the
     report's command imports)."""
-    return {"record": sha256(Path(record) / MANIFEST), "templates": _files(Path(templates), "*.md.j2"),
+    held = [Path(record) / name for name in (MANIFEST, PROFILE) if (Path(record) / name).exists()]
+    return {"record": "".join(sha256(path) for path in held), "templates": _files(Path(templates), "*.md.j2"),
             "configs": _files(CONF_DIR, "*.yaml"), "published": sha256(published) if Path(published).exists() else "",
             "code": run_code_digest(("report/__main__.py",))}
 

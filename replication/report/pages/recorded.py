@@ -6,7 +6,6 @@ writes :data:`STATUS` there (:func:`write_status`); ``pf-replicate verify agains
 :data:`~replication.record.manifest.RECOMPUTED` beside it.  :func:`recorded` reads both for the index.
 """
 
-import datetime
 import json
 from pathlib import Path
 
@@ -19,13 +18,15 @@ STATUS = "status.json"
 
 
 def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed: dict[str, int],
-                 drawn_from: dict[str, str]) -> Path:
+                 drawn_from: dict[str, str], profile: dict | None = None) -> Path:
     """``<out>/status.json``: the manifest's account of the runs drawn (their count, CPU time, commits,
-    dates, the size of their files, the machines and libraries that made them), per experiment how many of its
+    dates, the size of their files, the machines and libraries that made them), per experiment what it took
+    and what its previous recording took (``before``), how many of its
     recorded runs other code or settings than this checkout's made (``stale``), per multiverse how many
     universes its design has beside those recorded (``designed``; 0 for an experiment), and what the pages were
     drawn from (``drawn_from``: the digests of the record, the configs, the published values and the
-    drawing code, so that pages drawn from other inputs are drawn again before findings are rendered)."""
+    drawing code, so that pages drawn from other inputs are drawn again before findings are rendered), and
+    the record's ``profile`` (:func:`~replication.record.manifest.read_profile`) as it is."""
     entries = {name: manifest.experiments[name] for name in stale}
     status = {
         "drawn_from": drawn_from,
@@ -40,22 +41,21 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
         "last": max((e.last_computed for e in entries.values() if e.last_computed), default=None),
         "experiments": {name: {"runs": entries[name].runs, "stale": n, "universes": entries[name].universes,
                                "designed": designed.get(name, 0),
-                               "minutes": None if entries[name].universes else _minutes(entries[name]),
-                               "cpu_minutes": round(entries[name].wall_s / 60, 1)} for name, n in stale.items()},
+                               "minutes": entries[name].minutes, "cpu_minutes": round(entries[name].wall_s / 60, 1),
+                               "before": _before(entries[name].before)} for name, n in stale.items()},
     }
+    status["profile"] = profile
     path = out / STATUS
     path.write_text(json.dumps(status, indent=1) + "\n")
     return path
 
 
-def _minutes(entry) -> float | None:
-    """Minutes between the completion of the experiment's first and last recorded runs: its wall time on the
-    machine that made it, less its first run (runs in parallel; None without times).  Not for a multiverse,
-    whose universes reuse runs its experiments made at other times."""
-    if entry.first_computed is None:
+def _before(before) -> dict | None:
+    """What the recording an entry replaced took, as the status shows it (None if it replaced none)."""
+    if before is None:
         return None
-    first, last = (datetime.datetime.fromisoformat(t) for t in (entry.first_computed, entry.last_computed))
-    return round((last - first).total_seconds() / 60, 1)
+    return {"minutes": before.minutes, "cpu_minutes": round(before.wall_s / 60, 1),
+            "commits": sorted({c[:7] for c in before.commits}), "written": before.written}
 
 
 def recorded(reports: Path, papers: tuple[Paper, ...]) -> dict | None:
