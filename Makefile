@@ -8,8 +8,9 @@
 #                  lacks, universe by universe, then recorded)
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
-# make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does)
-#                  and render each paper's findings from it (docs/findings/, from docs/findings/templates/)
+# make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does),
+#                  profile its three costliest experiments into it (record/profile.json), and render each
+#                  paper's findings from it (docs/findings/, from docs/findings/templates/)
 # make findings    render each paper's findings from the record into docs/findings/ (after editing a template)
 # make verify      re-compute N (200) recorded runs here and compare them with the record; N=all for every one
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
@@ -67,7 +68,7 @@ test-all: setup browser
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
-	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python -m replication findings)
+	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python benchmarks/profile_run.py --record && $(BIN)/python -m replication findings)
 	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
 	$(BIN)/python -m replication.report.pages.calibration
@@ -82,6 +83,7 @@ readings: setup
 
 record: setup
 	$(BIN)/python -m replication record
+	$(BIN)/python benchmarks/profile_run.py --record
 	$(BIN)/python -m replication findings
 
 findings: setup

@@ -16,10 +16,9 @@
    per frame against the number of targets M (the paper claims O(M)).
 6. With ``--profiles`` (``make benchmark``): where a paper-scale run's time goes in the three
    experiments that cost the shipped record the most CPU, each method profiled on its recorded run of
-   median time (``profile_run.py``'s profile, after a warm-up run as a worker has had): its time by part
-   of the run (frames, likelihood, filter, scoring, the rest) and by library, and its costliest
-   functions; written also into ``record/profile.json``, from which ``pf-replicate findings`` renders
-   the README's and the findings' account of where the time goes.
+   median time (``profile_run.py --record``'s profiles, which ``make record`` writes into the record):
+   its time by part of the run (frames, likelihood, filter, scoring, the rest) and by library, and its
+   costliest functions.
 5. Issue 34's two ratios, each measured ROUNDS times in this run (median and
    range): the likelihood against the calcHist loop at N = 1000, the two
    timed in turn (>= 15), and BIS-PF against the paper's frame rate (>= 15);
@@ -41,7 +40,6 @@ import os
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads BLAS
     os.environ.setdefault(_variable, "1")
 
-import json  # noqa: E402
 import platform  # noqa: E402
 from pathlib import Path  # noqa: E402
 import re  # noqa: E402
@@ -62,13 +60,10 @@ from markupsafe import Markup  # noqa: E402
 from replication import PointMassFilter, bootstrap  # noqa: E402
 from replication.models import UNGM  # noqa: E402
 from replication.paths import resolve  # noqa: E402
-from replication.record.manifest import PROFILE  # noqa: E402
 from replication.report.pages.index import write_index  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
-from replication.runner.execute import perform  # noqa: E402
 from replication.runner.memory import retain_freed_memory  # noqa: E402
-from replication.runner.provenance import provenance  # noqa: E402
-from profile_run import REST, STAGES, profiled, runs_of, staged  # noqa: E402  (benchmarks/: the script's own folder)
+from profile_run import slowest_profiles  # noqa: E402  (benchmarks/: the script's own folder)
 from replication.scenes import SyntheticScene  # noqa: E402
 from replication.smc.resampling import RESAMPLERS  # noqa: E402
 from replication.vision.colour import ColourLikelihood  # noqa: E402
@@ -322,56 +317,6 @@ def scaling_plot(scaling: pd.DataFrame, path) -> None:
     plt.close(fig)
 
 
-def slowest_profiles(record: Path, count: int = 3, top: int = 6) -> pd.DataFrame:
-    """The ``count`` experiments of the record with the most CPU (the sum of their runs' times), costliest
-    first, and in each every method, costliest first, on its recorded run of median time, performed here
-    once and then under cProfile: the method's share of the experiment's CPU, the run's seconds, their
-    shares by part of the run (``part: frames`` ...) and by library (``library: numpy`` ...), and its
-    ``top`` functions by own time.  A run this code does not make (an older record's key) is named, not
-    profiled."""
-    spent = {folder.name: pd.read_parquet(folder / "runs.parquet", columns=["method", "run_key", "repetition", "wall_s"])
-             for folder in sorted(record.iterdir()) if (folder / "runs.parquet").exists()}
-    rows = []
-    for name in sorted(spent, key=lambda n: -spent[n]["wall_s"].sum())[:count]:
-        runs, keys = spent[name], {(r.key, r.repetition): r for r in runs_of(name, "paper")}
-        by_method = runs.groupby("method")["wall_s"].sum().sort_values(ascending=False)
-        for method, cpu in by_method.items():
-            mine = runs[runs["method"] == method].sort_values("wall_s", kind="stable")
-            median = mine.iloc[(len(mine) - 1) // 2]  # the lower of two middles
-            row = {"experiment": name, "record CPU-minutes": runs["wall_s"].sum() / 60, "method": method,
-                   "share of the experiment's CPU": cpu / runs["wall_s"].sum(), "recorded s": median["wall_s"]}
-            run = keys.get((median["run_key"], median["repetition"]))
-            if run is None:  # the record was made by other code: its run is not this code's
-                rows.append({**row, "run": f"{median['run_key']}: not in this code's runs (the record is older)"})
-                continue
-            perform(run)  # a worker's state after its first run: frames decoded, kernels compiled
-            seconds, shares, stats = profiled(run)
-            own = sorted(stats.stats.items(), key=lambda item: -item[1][2])[:top]
-            rows.append({**row, "run": run.run_id, "profiled s": seconds,
-                         **{f"part: {part}": t / seconds for part, t in staged(stats).most_common()},
-                         **{f"library: {part}": t / seconds for part, t in shares.most_common()},
-                         "costliest functions (own s)": "; ".join(f"{f} ({Path(file).name}:{line}) {v[2]:.2f}"
-                                                                  for (file, line, f), v in own)})
-    return pd.DataFrame(rows)
-
-
-def write_profile(profiles: pd.DataFrame, record: Path) -> Path:
-    """``record/profile.json``: the profiles of :func:`slowest_profiles` (each experiment's CPU, each method's
-    share of it and its run's split by part) and what made them, for ``pf-replicate findings`` to render."""
-    made = provenance()
-    methods = [{"experiment": row["experiment"], "method": row["method"],
-                "cpu_minutes": round(row["record CPU-minutes"] * row["share of the experiment's CPU"], 1),
-                "share": round(row["share of the experiment's CPU"], 3), "run": row["run"],
-                "parts": {c.removeprefix("part: "): round(row[c], 3) for c in profiles.columns
-                          if c.startswith("part: ") and pd.notna(row[c])}}
-               for _, row in profiles.iterrows()]
-    path = record / PROFILE
-    path.write_text(json.dumps({"made": {k: made[k] for k in ("git_commit", "code_digest", "machine", "computed_at")},
-                                "stages": list(dict.fromkeys([*STAGES.values(), REST])), "methods": methods},
-                               indent=1) + "\n")
-    return path
-
-
 def main() -> None:
     retain_freed_memory()  # as every experiment's run does
     out = resolve("reports") / "benchmark"
@@ -386,8 +331,6 @@ def main() -> None:
     profiles = slowest_profiles(resolve("record")) if "--profiles" in sys.argv[1:] and resolve("record").is_dir() \
         else pd.DataFrame([{"experiment": "not profiled in this run (make benchmark profiles them: benchmark.py "
                                           "--profiles, about 2 min)"}])
-    if "part: filter" in profiles:  # profiled: recorded beside the record, for the findings
-        print(f"profile: {write_profile(profiles, resolve('record'))}")
     for name, table in (("likelihood", likelihood), ("likelihood_rounds", rounds), ("instructions", counted),
                         ("smc_core", core), ("rendering", render_cost), ("bis_pf_speed", bis_speed),
                         ("bis_pf_profile", bis_profile), ("bis_pf_scaling", bis_scaling), ("ratios", summary),

@@ -53,8 +53,7 @@ def test_the_benchmark_profiles_every_method_of_the_costliest_experiments_on_its
 
     sys.path.insert(0, str(SCRIPT.parent))
     try:
-        from benchmark import slowest_profiles, write_profile
-        from profile_run import runs_of
+        from profile_run import runs_of, slowest_profiles, write_profile
     finally:
         sys.path.remove(str(SCRIPT.parent))
     runs = [r for r in runs_of("hspf_ungm", "paper") if r.repetition == 0]
