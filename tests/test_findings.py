@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from replication.paths import PACKAGE_DIR
-from replication.record.manifest import MANIFEST, PAGES, sha256
+from replication.record.manifest import MANIFEST, PAGES
 from replication.report.__main__ import findings, main as report
 from replication.report.findings import (README, README_MARKS, README_TEMPLATE, Drawn, drawn_inputs, duration, estimate,
-                                         inputs, number, readme_part, render, stale, write_html,
+                                         inputs, number, readme_part, record_digest, render, stale, write_html,
                                          write_pages)
 
 ROOT = PACKAGE_DIR.parent
@@ -68,7 +68,7 @@ def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages)
     assert not stale, f"docs/findings/ differs from what the record renders for {stale}: run pf-replicate findings"
     assert (shipped_pages / PAGES / "findings" / "bis_pf.html").exists()  # and the record's pages show them
     status = json.loads((shipped_pages / PAGES / "status.json").read_text())
-    assert status["drawn_from"]["record"] == sha256(ROOT / "record" / MANIFEST)
+    assert status["drawn_from"]["record"] == record_digest(ROOT / "record")  # its manifest and profile
     assert f"{status['runs']:,} runs" in pages["index"]
 
 

@@ -18,7 +18,7 @@ every number it quotes taken from the record's drawn pages (``<reports>/record``
   experiments' cost, as Markdown tables.
 
 - ``parts()``: the record's parts (the experiments together, each multiverse) and what each took.
-- ``where_time_goes(by_method)``: the record's profile (``record/profile.json``, made by ``make benchmark``)
+- ``where_time_goes(by_method)``: the record's profile (``record/profile.json``, made by ``make record``)
   of its slowest experiments as a Markdown table, a row per experiment (its methods' parts weighted by
   their CPU) or per method; ``profiled``: what made it (commit, machine), ``profiled_experiments``: how many.
 
@@ -156,6 +156,7 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     """The names a template may use (see the module's docstring); ``paper`` its paper's key (or ``index``)."""
     claims = drawn.claims.set_index("claim_id", drop=False)
     status = drawn.status
+    profile = status.get("profile") or {}  # where the slowest experiments' time goes (none: not profiled)
 
     def claim(claim_id: str) -> dict:
         if claim_id not in claims.index:
@@ -216,9 +217,8 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         return markdown_table(["part", "runs", "universes", "CPU-hours", "on 2 workers", "before"], rows)
 
     def where_time_goes(by_method: bool) -> str:
-        profile = status.get("profile")
         if not profile:
-            raise LookupError("the record has no profile (make benchmark writes record/profile.json)")
+            raise LookupError("the record has no profile (make record writes record/profile.json)")
         methods = pd.DataFrame([{"experiment": m["experiment"], "method": m["method"], "cpu": m["cpu_minutes"],
                                  **m["parts"]} for m in profile["methods"] if m["parts"]])
         stages = [s for s in profile["stages"] if s in methods]
@@ -233,7 +233,6 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
                               [[f"`{r['experiment']}`", *([r["method"]] if by_method else []), number(r["cpu"]),
                                 *(number(round(100 * r[s], 1)) for s in stages)] for _, r in rows.iterrows()])
 
-    profile = status.get("profile") or {}
     return {"paper": papers.get(paper), "papers": papers, "page": paper,
             "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
             "claim": claim, "table": drawn.table, "experiment": experiment, "verdicts": verdicts,
@@ -289,10 +288,15 @@ def inputs(record: Path, templates: Path, published: Path) -> dict[str, str]:
     every file's, and its profile's), the templates, the configs (the claims' words, the experiments' methods and tables), the
     papers' published values, and the code that draws the record's pages and renders them (every module the
     report's command imports)."""
-    held = [Path(record) / name for name in (MANIFEST, PROFILE) if (Path(record) / name).exists()]
-    return {"record": "".join(sha256(path) for path in held), "templates": _files(Path(templates), "*.md.j2"),
+    return {"record": record_digest(record), "templates": _files(Path(templates), "*.md.j2"),
             "configs": _files(CONF_DIR, "*.yaml"), "published": sha256(published) if Path(published).exists() else "",
             "code": run_code_digest(("report/__main__.py",))}
+
+
+def record_digest(record: Path) -> str:
+    """The record as its pages depend on it: its manifest's SHA-256 (which holds every file's), then its
+    profile's where it has one."""
+    return "".join(sha256(Path(record) / name) for name in (MANIFEST, PROFILE) if (Path(record) / name).exists())
 
 
 def drawn_inputs(rendered_from: dict[str, str]) -> dict[str, str]:

@@ -43,8 +43,8 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
                                "designed": designed.get(name, 0),
                                "minutes": entries[name].minutes, "cpu_minutes": round(entries[name].wall_s / 60, 1),
                                "before": _before(entries[name].before)} for name, n in stale.items()},
+        "profile": profile,
     }
-    status["profile"] = profile
     path = out / STATUS
     path.write_text(json.dumps(status, indent=1) + "\n")
     return path
