@@ -424,3 +424,38 @@ def test_a_run_gives_the_same_bits_whatever_blas_threads_its_process_has():
         assert done.returncode == 0, done.stderr
         results.add(done.stdout.split()[-1])
     assert len(results) == 1, results
+
+
+MIL_RUN = """
+import json, sys
+import cv2
+from hydra import compose, initialize_config_dir
+from replication.paths import CONF_DIR
+from replication.runner.config import expand
+from replication.runner.execute import TIMING_COLUMNS, _performed, perform
+with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+    cfg = compose("config", overrides=["experiment=hspf", "scale=quick"])
+run = [r for r in expand(cfg) if r.method == "MIL" and str(r.condition) == "scene=Girl"][0]
+if sys.argv[1] == "pool":
+    cv2.setNumThreads(2)
+    record = _performed(run)
+else:
+    record = perform(run)
+record["per_frame"].pop("seconds")
+print(cv2.getNumThreads(), json.dumps({k: v for k, v in record.items() if k not in TIMING_COLUMNS}, sort_keys=True))
+"""
+
+
+@pytest.mark.e2e
+def test_a_run_computes_on_one_opencv_thread_and_gives_what_a_pool_of_them_gives():
+    """perform leaves OpenCV one thread (its pool spun on every core of every worker), and a run that
+    uses OpenCV's threads most, MIL's samples, gives the same record on a pool of two as on one: so the
+    runs recorded before the limit stand."""
+    outputs = {}
+    for arm in ("pool", "perform"):
+        done = subprocess.run([sys.executable, "-c", MIL_RUN, arm], capture_output=True, text=True,
+                              cwd=PROJECT_ROOT, timeout=300)
+        assert done.returncode == 0, done.stderr
+        outputs[arm] = done.stdout.strip().splitlines()[-1].split(" ", 1)
+    assert outputs["pool"][0] == "2" and outputs["perform"][0] == "1"
+    assert outputs["pool"][1] == outputs["perform"][1]

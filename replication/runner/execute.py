@@ -35,7 +35,7 @@ from replication.errors import RunFailed
 from replication.run import Run
 from replication.runner.failures import failure
 from replication.runner.lifeline import start_worker
-from replication.runner.memory import one_blas_thread, retain_freed_memory
+from replication.runner.memory import one_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
 from replication.tasks import TASKS
@@ -65,7 +65,7 @@ def perform(run: Run) -> dict:
     from numba.core import event  # here: the command line checks a request before anything heavy is imported
 
     retain_freed_memory()  # in whichever process computes it: a worker of any backend
-    one_blas_thread()
+    one_thread()
     with event.install_recorder("numba:compile") as compiled:
         record = _performed(run)
     return _performed(run) if compiled.buffer and "failure" not in record else record

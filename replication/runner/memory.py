@@ -1,4 +1,5 @@
-"""How a process that computes runs is set up: freed memory kept for reuse, and one BLAS thread.
+"""How a process that computes runs is set up: freed memory kept for reuse, and one thread (BLAS's and
+OpenCV's).
 
 Keep freed memory in the process instead of handing it back to the OS at every ``free``.
 
@@ -37,12 +38,22 @@ def retain_freed_memory() -> bool:
 
 
 @cache
-def one_blas_thread() -> None:
-    """Every run computes its matrix products with one BLAS thread, in whichever process computes it.
+def one_thread() -> None:
+    """Every run computes on one thread, BLAS's and OpenCV's, in whichever process computes it.
 
-    loky's workers get one thread each (two cores, two jobs), but a run computed in the main process
+    BLAS: loky's workers get one thread each (two cores, two jobs), but a run computed in the main process
     (``n_jobs=1``) had every core: OpenBLAS then splits a product differently and the sums come out in
     another order, so the grid filter's RMSE at T = 100 differed in its last bit between one job and two
-    (5.902905369091446 against ...445, one run of ungm_horizon's 1500).  The limit stays on for the
-    process (once is enough; the libraries are loaded by then)."""
+    (5.902905369091446 against ...445, one run of ungm_horizon's 1500).
+
+    OpenCV: loky limits BLAS and OpenMP, not OpenCV's own pool of pthreads, which kept a thread per core
+    in every worker; its threads spin while they wait, so two workers on two cores ran up to four busy
+    threads.  One MIL run (hspf, CarScale) took 7.1 s and 11.7 CPU-seconds so, 6.4 s and 6.4 on one
+    thread.  OpenCV splits its work by pixels or samples, each computed alone, so the numbers do not
+    change: hspf's runs at paper scale were identical in every column but the timings.
+
+    The limits stay on for the process (once is enough; the libraries are loaded by then)."""
     threadpool_limits(limits=1, user_api="blas")
+    import cv2  # here: the command line checks a request before anything heavy is imported
+
+    cv2.setNumThreads(1)
