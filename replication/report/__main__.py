@@ -125,9 +125,9 @@ def main(argv: list[str]) -> None:
 
 def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[str, Path | None, int | None, int]:
     """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``): its name, its
-    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said), from the
-    record how many of its recorded runs other code made, and a multiverse's universes by its design (0 for
-    an experiment)."""
+    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said), and from
+    the record how many of its recorded runs other code made and a multiverse's universes by its design
+    (from the store: None and 0; an experiment has 0 universes)."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         try:
             check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
@@ -147,7 +147,7 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
                 len(multiverse.universes)
         if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
             multiverse = load_multiverse(cfg)
-            return name, write_multiverse_report(cfg, multiverse, tuple(overrides)), None, len(multiverse.universes)
+            return name, write_multiverse_report(cfg, multiverse, tuple(overrides)), None, 0
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
