@@ -68,7 +68,7 @@ test-all: setup browser
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
-	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record && $(BIN)/python benchmarks/profile_run.py --record && $(BIN)/python -m replication findings)
+	$(if $(filter paper,$(SCALE)),$(MAKE) record)
 	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
 	$(BIN)/python -m replication.report.pages.calibration

@@ -11,21 +11,24 @@ b alike).  The script prints that bound for the experiments and for ``bis_pf_rea
 record took, and the workers the record's CPU needs for 30 minutes and for 2 hours.
 """
 
-import json
 import math
 import sys
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-ROOT = Path(__file__).resolve().parent.parent
-RECORD = ROOT / "record"
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from replication.paths import resolve  # noqa: E402
+from replication.record.manifest import MANIFEST, Manifest  # noqa: E402
+from replication.record.runs import UNIVERSES_DIR  # noqa: E402
+
 BALLS = ("exp1_3123", "exp2_16_targets", "exp3_36_targets")
 FILTERS = ("MIPF", "BIS-PF", "DMOT", "MFMC", "MCMC")  # the record's multi-target filters; BIS-PF-K and -beta are BIS-PF
 QUADRATIC_FROM = {"MFMC": 400}  # the largest N fitted: past it the step is no longer linear in N
 FIT_ON = "bis_pf_cost"
-BIS = ("bis_pf", "bis_pf_cost", "bis_pf_ablation", "bis_pf_scaling", "bis_pf_pets", "bis_pf_pets_tuning")
+READINGS = "bis_pf_readings"  # the multiverse of those filters on the balls
 
 
 def step_seconds(runs: pd.DataFrame) -> pd.Series:
@@ -43,37 +46,41 @@ def fixed_costs(runs: pd.DataFrame) -> dict[str, tuple[float, float]]:
     return fits
 
 
-def bound(runs: pd.DataFrame, fits: dict[str, tuple[float, float]]) -> tuple[float, float]:
-    """(CPU seconds of ``runs``, at most what removing each filter's fixed cost would save of them)."""
+def bound(runs: pd.DataFrame, fits: dict[str, tuple[float, float]]) -> float:
+    """At most what removing each filter's fixed cost would save of ``runs``' CPU seconds (0 for runs that
+    are no such filter's on the balls, or an experiment without scenes or frames)."""
+    if not {"condition.scene", "ms_per_frame"} <= set(runs.columns):
+        return 0.0
     filter_of = runs["method"].str.replace(r"^BIS-PF-.*", "BIS-PF", regex=True)
     ours = filter_of.isin(FILTERS) & runs["condition.scene"].isin(BALLS)
     a = filter_of[ours].map({m: a for m, (a, _) in fits.items()}).astype(float)
     b = filter_of[ours].map({m: b for m, (_, b) in fits.items()}).astype(float)
     share = a / (a + b * runs.loc[ours, "method.n_particles"])
-    return float(runs["wall_s"].sum()), float((share * step_seconds(runs[ours])).sum())
+    return float((share * step_seconds(runs[ours])).sum())
 
 
 def main() -> None:
-    if not (RECORD / "manifest.json").exists():
-        sys.exit(f"{RECORD}: no record here")
-    experiments = json.loads((RECORD / "manifest.json").read_text())["experiments"]
-    fits = fixed_costs(pd.read_parquet(RECORD / FIT_ON / "runs.parquet"))
+    record = resolve("record")
+    if not (record / MANIFEST).exists():
+        sys.exit(f"{record}: no record here")
+    entries = Manifest.read(record).experiments
+    fits = fixed_costs(pd.read_parquet(record / FIT_ON / "runs.parquet"))
     print(f"fixed cost of a frame step on the 16 balls ({FIT_ON}, a + b N):")
     for method, (a, b) in fits.items():
-        per_target = a / (999 * 16) * 1e6  # 999 steps of 16 targets a run
-        print(f"  {method:7s} a = {a:4.2f} s a run ({per_target:3.0f} us a target and frame), b = {b * 1e3:5.2f} ms a particle")
-    solo = {name: e for name, e in experiments.items() if not e["universes"]}
-    cpu = sum(e["wall_s"] for e in solo.values())
-    bis_cpu, saved = map(sum, zip(*(bound(pd.read_parquet(RECORD / name / "runs.parquet"), fits) for name in BIS)))
-    print(f"the {len(solo)} experiments: {cpu / 60:.1f} CPU-min ({bis_cpu / 60:.1f} in bis_pf's); at most "
-          f"{saved / 60:.1f} saved: {cpu / 120:.1f} -> {(cpu - saved) / 120:.1f} min on 2 workers")
-    universes = pd.concat(pd.read_parquet(p) for p in sorted((RECORD / "bis_pf_readings" / "universes").glob("*.parquet")))
-    readings, saved_readings = bound(universes, fits)
-    rest = sum(e["wall_s"] for name, e in experiments.items() if e["universes"] and name != "bis_pf_readings")
-    print(f"bis_pf_readings: {readings / 3600:.2f} CPU-h; at most {saved_readings / 3600:.2f} saved; all multiverses: "
-          f"{(readings + rest) / 7200:.1f} -> {(readings + rest - saved_readings) / 7200:.1f} h on 2 workers")
+        per_target = a / (999 * 16)  # bis_pf_cost: 999 steps of 16 targets a run
+        print(f"  {method:7s} a = {a:4.2f} s a run ({per_target * 1e6:3.0f} us a target and frame), b = {b * 1e3:5.2f} ms a particle")
+    solo = [name for name, e in entries.items() if not e.universes]
+    cpu = sum(entries[name].wall_s for name in solo)
+    saved = sum(bound(pd.read_parquet(record / name / "runs.parquet"), fits) for name in solo)
+    print(f"the {len(solo)} experiments: {cpu / 60:.1f} CPU-min; at most {saved / 60:.1f} saved: "
+          f"{cpu / 120:.1f} -> {(cpu - saved) / 120:.1f} min on 2 workers")
+    universes = sorted((record / READINGS / UNIVERSES_DIR).glob("*.parquet"))
+    readings, saved_readings = entries[READINGS].wall_s, bound(pd.concat(pd.read_parquet(p) for p in universes), fits)
+    multiverses = sum(e.wall_s for e in entries.values() if e.universes)
+    print(f"{READINGS}: {readings / 3600:.2f} CPU-h; at most {saved_readings / 3600:.2f} saved; all multiverses: "
+          f"{multiverses / 7200:.1f} -> {(multiverses - saved_readings) / 7200:.1f} h on 2 workers")
     print(f"workers the record's CPU needs: {math.ceil(cpu / 1800)} for the experiments in 30 min, "
-          f"{math.ceil((readings + rest) / 7200)} for the multiverses in 2 h")
+          f"{math.ceil(multiverses / 7200)} for the multiverses in 2 h")
 
 
 if __name__ == "__main__":
