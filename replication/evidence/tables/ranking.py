@@ -50,7 +50,7 @@ class RankingTable(TableKind):
 class Pairwise(TableKind):
     """Every pair of ranked methods, the better-ranked first: the probability that A's mean over the
     sequences beats B's (two-level bootstrap), the mean of the paired per-sequence differences A - B
-    with its BCa interval over the sequences, and on how many sequences A is ahead."""
+    with its t interval over the sequences, and on how many sequences A is ahead."""
 
     kind = "pairwise"
     compares = False
