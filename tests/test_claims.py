@@ -219,11 +219,11 @@ def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_lin
     assert [paper.key for paper in own] == ["apf"] and [c.id for c in own[0].claims] == ["apf.ungm"]
     with pytest.raises(ConfigError, match="no claims file"):
         load_own_papers(tmp_path)
-    head = "paper: mine\norder: 7\ntitle: t\nauthors: a\nvenue: v\nclaims:\n  - id: mine.x\n    claim: c\n"
+    head = "paper: mine\norder: 7\ntitle: t\nauthors: a\nvenue: v\nclaims:\n  - id: mine.x\n"
     (tmp_path / "mine.yaml").write_text(head + "    readings: []\n")
-    with pytest.raises(ConfigError, match=r"mine.yaml lacks the key 'source'; see conf/claims/\*.yaml$"):
+    with pytest.raises(ConfigError, match=r"mine.yaml lacks the key 'claim'; see conf/claims/\*.yaml$"):
         load_own_papers(tmp_path)
-    (tmp_path / "mine.yaml").write_text(head + "    source: s\n    readings:\n"
+    (tmp_path / "mine.yaml").write_text(head + "    claim: c\n    where: s\n    readings:\n"
                                         "      - {name: r, experiment: e, test: faster}\n")
     with pytest.raises(ConfigError, match=r"mine.yaml: unknown claim test 'faster'; known: .*order"):
         load_own_papers(tmp_path)
@@ -231,15 +231,22 @@ def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_lin
 
 def test_threshold():
     records = _records({"A": 0.0, "B": 1.0}, metric="fps")
-    assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 2.0,
-                     "statistic": "median"}, records).outcome is Outcome.REPRODUCED
-    assert _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 50.0},
-                    records).outcome is Outcome.NOT_REPRODUCED
+    here = {"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "machine": "this"}
+    assert _verdict({**here, "at_least": 2.0, "statistic": "median"}, records).outcome is Outcome.REPRODUCED
+    assert _verdict({**here, "at_least": 50.0}, records).outcome is Outcome.NOT_REPRODUCED
     # 5 runs all above the bound: the exact sign test's floor, 1/32, decides (no order-statistic 95% interval)
     five = _records({"A": 20.0}, runs=5, metric="fps")
-    verdict = _verdict({"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 5.52,
-                        "statistic": "median"}, five)
+    verdict = _verdict({**here, "at_least": 5.52, "statistic": "median"}, five)
     assert verdict.outcome is Outcome.REPRODUCED and verdict.p_for == pytest.approx(1 / 32)
+
+
+def test_a_time_measured_on_another_machine_is_not_testable_and_the_ratio_is_shown():
+    five = _records({"A": 20.0}, runs=5, metric="fps")
+    spec = {"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 5.52}
+    verdict = _verdict(spec, five)
+    median = float(np.median(five.loc[five["method"] == "A", "fps"]))
+    assert verdict.outcome is Outcome.NOT_TESTABLE
+    assert f"ours / theirs = {median / 5.52:.3g}" in verdict.why
 
 
 def test_result_combines_checks():

@@ -38,6 +38,8 @@ from replication.paths import CONF_DIR
 from replication.qmc import discrepancy_table
 from replication.evidence.published import cells as published_cells
 from replication.evidence.ranking import rankings, unreliable
+from replication.evidence.trends import dominance, log_log_slope
+from replication.condition import values_of
 from replication.evidence.tables import Table, match, pair
 from replication.evidence.settings import INFERENCE
 
@@ -51,12 +53,14 @@ class Reading:
     name: str
     experiment: str
     test: dict
+    ours: str = ""  # what this reading adds to the paper's words (a sequence it did not use, equal cost): never
+    # the primary reading's
 
     @property
     def basis(self) -> str:
         """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
         they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
-        return ClaimTest.registry[self.test["test"]].basis(self.test)
+        return ClaimTest.registry[self.test["test"]].basis(self.test) if self.test else ""
 
     @property
     def compared_at(self) -> str:
@@ -65,14 +69,25 @@ class Reading:
 
 
 @dataclass(frozen=True)
+class Quote:
+    """The paper's own words for a claim, as its text prints them (``text``, the original language) and
+    in English."""
+
+    text: str
+    english: str
+
+
+@dataclass(frozen=True)
 class Claim:
     id: str
     paper: str
-    text: str
-    source: str
+    text: str  # the claim in plain words, saying no more than its quote
+    quote: Quote
+    where: str  # section, table or figure (and page) as the paper's text gives them
     cells: dict  # which published cells belong to it: {column: [values]}, every column matching
     readings: tuple[Reading, ...]
     note: str = ""
+    untestable: str = ""  # why no reading tests it here (a private video with no stand-in, a lost table)
 
     def owns(self, cell: pd.Series) -> bool:
         """Whether a published cell (a row of ``published_values.csv``) belongs to this claim."""
@@ -421,6 +436,8 @@ class Threshold(ClaimTest):
         kind = quantity(metric)
         values = chosen[metric].to_numpy(float)
         bound, above = (spec["at_least"], True) if "at_least" in spec else (spec["at_most"], False)
+        if kind.machine_dependent and spec.get("machine") != "this":  # a time measured on another machine
+            return [_elsewhere(spec, values, bound, chosen)]
         if kind.proportion:
             test = proportion_test(int(round(values.sum() / kind.high)), len(values), bound / kind.high)
             factor = kind.high
@@ -435,6 +452,16 @@ class Threshold(ClaimTest):
         return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
                       dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound),
                       timed=kind.machine_dependent)]
+
+
+def _elsewhere(spec: dict, values: np.ndarray, bound: float, chosen: pd.DataFrame) -> Check:
+    """A bound on a time or frame rate that the paper measured on its own machine: not testable here
+    (docs/statistics.md, "Times"), with our median over theirs shown."""
+    ours = float(np.median(values))
+    what = f"{spec['method']} median {spec['metric']} against the paper's {bound:g} (its machine)"
+    why = f"a time measured on another machine is not testable; ours / theirs = {ours / bound:.3g}"
+    return Check(what, Verdict(Outcome.NOT_TESTABLE, why), None, spec.get("unit", ""), float(bound),
+                 dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound), timed=True)
 
 
 def _threshold_verdict(p_for: float | None, p_against: float | None, against: str = "the other side of the bound",
@@ -463,7 +490,7 @@ class Best(ClaimTest):
 
     def checks(self, records, tables):
         metric, method = self.spec["metric"], self.spec["method"]
-        found = rankings(records, self.spec).get(self.spec.get("group", ""))
+        found = rankings(_ranked(records, self.spec), self.spec).get(self.spec.get("group", ""))
         if found is None or method not in found.methods:
             return []
         i = found.index(method)
@@ -486,6 +513,94 @@ class Best(ClaimTest):
                                              f"{other} is better", f"; {description}")
             checks.append(Check(what, verdict, difference, reference=0.0))
         return checks
+
+
+def _ranked(records: pd.DataFrame, spec: dict) -> pd.DataFrame:
+    """The runs a ranking claim is about: its ``among`` methods (with ``method``) and its ``sequences`` (values
+    of the variable ``over``); every one where unset."""
+    keep = pd.Series(True, index=records.index)
+    if spec.get("among"):
+        keep &= records["method"].isin([spec["method"], *spec["among"]])
+    if spec.get("sequences"):
+        keep &= values_of(records, spec.get("over", "scene")).isin(spec["sequences"])
+    return records[keep]
+
+
+class Rank(ClaimTest):
+    """``method`` ranks among the first ``top`` in mean ``metric`` over the sequences (``among``, ``sequences``,
+    ``over`` as for ``best``): its 95 % rank set (:func:`~replication.evidence.ranking.rank_set`: the paired
+    t-tests over the sequences, Holm across them) within ranks 1 to ``top``: reproduced; wholly below ``top``:
+    not reproduced; else inconclusive.  A ranking that is not reliable decides nothing."""
+
+    name = "rank"
+
+    def checks(self, records, tables):
+        method = self.spec["method"]
+        found = rankings(_ranked(records, self.spec), self.spec).get(self.spec.get("group", ""))
+        if found is None or method not in found.methods:
+            return []
+        rank, top = found.rank(found.index(method)), self.spec["top"]
+        what = f"{method}'s rank in mean {self.spec['metric']} among {len(found.methods)} over {len(found.sequences)} sequences, at most {top}"
+        caveat = unreliable(found, self.experiment)
+        if caveat:
+            verdict = Verdict(Outcome.NOT_TESTABLE, caveat)
+        elif rank.high <= top:
+            verdict = Verdict(Outcome.REPRODUCED, f"rank set [{rank.low:.0f}, {rank.high:.0f}]")
+        elif rank.low > top:
+            verdict = Verdict(Outcome.NOT_REPRODUCED, f"rank set [{rank.low:.0f}, {rank.high:.0f}]")
+        else:
+            verdict = Verdict(Outcome.INCONCLUSIVE, f"rank set [{rank.low:.0f}, {rank.high:.0f}] spans rank {top}")
+        return [Check(what, verdict, rank, reference=float(top))]
+
+
+class Growth(ClaimTest):
+    """``method``'s ``metric`` grows with the condition variable ``x`` (its values read as numbers) no faster
+    than x^``at_most``: the log-log slope over every run (:func:`~replication.evidence.trends.log_log_slope`),
+    reproduced where its upper bound lies below ``at_most``, not reproduced where its lower bound lies above."""
+
+    name = "growth"
+
+    def checks(self, records, tables):
+        spec = self.spec
+        runs = records[records["method"] == spec["method"]]
+        x = pd.to_numeric(values_of(runs, spec["x"]), errors="coerce").to_numpy(float)
+        values = runs[spec["metric"]].to_numpy(float)
+        kept = np.isfinite(x) & np.isfinite(values) & (x > 0) & (values > 0)
+        if kept.sum() < INFERENCE.min_runs:
+            return [Check(f"{spec['method']} {spec['metric']} against {spec['x']}", too_few(int(kept.sum())))]
+        slope = log_log_slope(x[kept], values[kept], spec["at_most"])
+        what = f"{spec['method']}: growth exponent of {spec['metric']} in {spec['x']} ({len(set(x[kept]))} values)"
+        verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec['x']}^{spec['at_most']:g}")
+        shown = Estimate(slope.value, slope.low, slope.high, slope.points, "least squares on logs, t, 90% CI")
+        return [Check(what, verdict, shown, reference=float(spec["at_most"]), paper=float(spec["at_most"]),
+                      timed=quantity(spec["metric"]).machine_dependent)]
+
+
+class Pareto(ClaimTest):
+    """``method`` at the ``chosen`` condition keeps both ``metrics`` (lower is better) small: against every other
+    condition of the method, one check (:func:`~replication.evidence.trends.dominance`, paired by run): reproduced
+    where, against each, the chosen setting is better on at least one metric; not reproduced where some other
+    setting is better on both, after Holm."""
+
+    name = "pareto"
+
+    def checks(self, records, tables):
+        spec, metrics = self.spec, list(self.spec["metrics"])
+        runs = records[records["method"] == spec["method"]]
+        keyed = runs.set_index(["data_condition", "repetition"])
+        chosen_label = str(spec["chosen"])
+        chosen = keyed[keyed["condition"] == chosen_label][metrics]
+        found = []
+        for other, rows in keyed[keyed["condition"] != chosen_label].groupby("condition", sort=False):
+            both = chosen.merge(rows[metrics], left_index=True, right_index=True, suffixes=("", " (other)")).dropna()
+            if len(both) < INFERENCE.min_runs:
+                continue
+            tested = dominance(both[metrics].to_numpy(), both[[f"{m} (other)" for m in metrics]].to_numpy())
+            gains = ", ".join(f"{m} {g:+.3g}" for m, g in zip(metrics, tested.gains))
+            verdict = _threshold_verdict(_finite(tested.p_for), _finite(tested.p_against), f"{other} is better on both")
+            found.append(Check(f"{chosen_label} against {other} (the other minus the chosen: {gains})", verdict,
+                               timed=any(quantity(m).machine_dependent for m in metrics)))
+        return found
 
 
 class Uniformity(ClaimTest):
@@ -545,11 +660,13 @@ def _paper(path: Path) -> tuple[int, Paper]:
     """One claims file: its paper's ``order`` and the paper with its claims."""
     data = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     claims = tuple(
-        Claim(id=c["id"], paper=data["paper"], text=c["claim"], source=c["source"], cells=c.get("cells") or {},
+        Claim(id=c["id"], paper=data["paper"], text=c["claim"], quote=Quote(**c.get("quote", {"text": "", "english": ""})),
+              where=c.get("where", ""), cells=c.get("cells") or {},
               readings=tuple(Reading(r["name"], r["experiment"], {k: v for k, v in r.items()
-                                                                  if k not in ("name", "experiment")})
-                             for r in c["readings"]),
-              note=c.get("note", ""))
+                                                                  if k not in ("name", "experiment", "ours")},
+                                     r.get("ours", ""))
+                             for r in c.get("readings") or ()),
+              note=c.get("note", ""), untestable=c.get("untestable", ""))
         for c in data["claims"]
     )
     return data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)

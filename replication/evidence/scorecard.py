@@ -85,9 +85,14 @@ def claim_rows(papers: list[Paper], summaries: dict[str, Summary]) -> dict[str, 
     its robustness across the paper's multiverse where one was run."""
     across = {claim: (name, stored) for name, summary in summaries.items()
               for claim, stored in summary.multiverse.items()}
-    return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings),
+    return {paper.key: [ClaimRow(claim, tuple(_result(claim, r, summaries) for r in claim.readings) or _untested(claim),
                                  *reversed(across.get(claim.id, ("", None))))
                         for claim in paper.claims] for paper in papers}
+
+
+def _untested(claim: Claim) -> tuple[ReadingResult]:
+    """A claim no reading tests here: not testable, for the reason its entry states."""
+    return (ReadingResult(Reading("none here", "", {}), Verdict(Outcome.NOT_TESTABLE, claim.untestable), None, (), ""),)
 
 
 def _result(claim: Claim, reading: Reading, summaries: dict[str, Summary]) -> ReadingResult:
@@ -141,7 +146,8 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
             deciding = row.primary.deciding
             estimate = deciding.estimate if deciding and deciding.estimate else None
             table.append({
-                "paper": paper, "claim_id": row.claim.id, "claim": row.claim.text, "source": row.claim.source,
+                "paper": paper, "claim_id": row.claim.id, "claim": row.claim.text, "where": row.claim.where,
+                "quote": row.claim.quote.text, "quote_english": row.claim.quote.english,
                 "verdict": row.verdict.outcome.value, "reason": row.verdict.why,
                 "number": estimate.value if estimate else None, "ci_low": estimate.low if estimate else None,
                 "ci_high": estimate.high if estimate else None, "runs": estimate.runs if estimate else None,

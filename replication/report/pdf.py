@@ -132,7 +132,7 @@ def _summary_frame(cells: pd.DataFrame) -> pd.DataFrame:
 def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     """One paper's claims as the scorecard prints them."""
     return pd.DataFrame({
-        "claim": [f"{r.claim.text} ({r.claim.source})" for r in rows],
+        "claim": [f"{r.claim.text} ({r.claim.where})" for r in rows],
         "verdict": [r.verdict.outcome.value for r in rows],
         "deciding number (90% CI)": [r.primary.deciding.number if r.primary.deciding else "" for r in rows],
         "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
