@@ -74,7 +74,8 @@ class ClaimRow:
         outcomes = {r.verdict.outcome for r in judged}
         if len(outcomes) == 1:
             return f"the same under all {len(judged)} readings"
-        listed = "; ".join(f"{r.verdict.outcome.value} under {r.reading.name}" for r in judged)
+        listed = "; ".join(f"{r.verdict.outcome.value} under {r.reading.name}{' (ours)' if r.reading.ours else ''}"
+                           for r in judged)
         if DECISIVE <= outcomes:  # each decisive verdict holds its error rate: a real conflict
             return f"hinges on the reading: {listed}"
         return f"no reading contradicts another (an inconclusive reading is no contradiction): {listed}"
