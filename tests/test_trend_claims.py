@@ -95,3 +95,19 @@ def test_a_rank_claim_reads_the_rank_set():
     assert _verdict(spec, _ranked(0.3)).outcome is Outcome.REPRODUCED
     assert _verdict(spec, _ranked(-0.5)).outcome is Outcome.NOT_REPRODUCED
     assert _verdict({**spec, "sequences": ["s0", "s1", "s2"]}, _ranked(0.3)).outcome is Outcome.NOT_TESTABLE
+
+
+def test_the_tests_run_over_a_batch_as_over_one_set():
+    """The calibration passes thousands of simulated experiments at once through the same code."""
+    rng = np.random.default_rng(17)
+    x = np.repeat([4.0, 9.0, 16.0, 36.0], 3)
+    y = np.exp(rng.normal(0, 0.1, (4, len(x)))) * x ** 1.2
+    batch = log_log_slope(x, y, 1.5)
+    for k in range(4):
+        one = log_log_slope(x, y[k], 1.5)
+        assert batch.value[k] == pytest.approx(float(one.value)) and batch.p_below[k] == pytest.approx(float(one.p_below))
+    chosen, other = rng.normal(0, 1, (4, 10, 2)), rng.normal(0.3, 1, (4, 10, 2))
+    both = dominance(chosen, other)
+    for k in range(4):
+        assert both.p_for[k] == pytest.approx(float(dominance(chosen[k], other[k]).p_for))
+        assert both.p_against[k] == pytest.approx(float(dominance(chosen[k], other[k]).p_against))

@@ -46,6 +46,7 @@ from replication.evidence.comparisons import Effect, best_test, order_test
 from replication.evidence.inference import holm, mean_test, sign_test
 from replication.evidence.ranking import rank, rank_set
 from replication.evidence.robustness import depends
+from replication.evidence.trends import dominance, log_log_slope
 from replication.evidence.quantities import Quantity
 from replication.evidence.verdict import OUTCOMES, Outcome, cell_test, decide, judge_band, judge_value, stability_bands
 from replication.evidence.settings import INFERENCE
@@ -306,6 +307,40 @@ def robustness_case(runs, distribution, truth, guards, effect, alternatives=4) -
     return Case("multiverse robustness", runs, alternatives, distribution, truth, guards, effect, draw)
 
 
+GROWTH_X = np.repeat([4.0, 9.0, 16.0, 25.0, 36.0, 64.0], 3)  # bis_pf_scaling: 6 numbers of targets x 3 runs
+GROWTH_BOUND = 1.5  # bis_pf.linear's at_most
+PARETO_SETTINGS, PARETO_RUNS = 30, 20  # hspf_ungm_sweep: 6 NI x 5 HMS, 20 runs at paper scale
+
+
+def growth_case(distribution, truth, guards, exponent, spread=0.1) -> Case:
+    """A time ~ M^``exponent`` over :data:`GROWTH_X`, each point with its own multiplicative noise of log-sd
+    ``spread``, against :data:`GROWTH_BOUND` (null: the exponent at the bound)."""
+    def draw(rng, reps):
+        logs = exponent * np.log(GROWTH_X) + spread * noise(distribution, rng, (reps, len(GROWTH_X)))
+        slope = log_log_slope(GROWTH_X, np.exp(logs), GROWTH_BOUND)
+        return _reading(slope.p_below[:, None], slope.p_above[:, None])
+    return Case("growth", len(GROWTH_X), 1, distribution, truth, guards, exponent, draw)
+
+
+def pareto_case(distribution, truth, guards, rival, others=3.0) -> Case:
+    """The chosen setting against :data:`PARETO_SETTINGS` - 1 others on two metrics (lower is better) over
+    :data:`PARETO_RUNS` runs on common random numbers: the first rival ahead by ``rival`` (standard deviations
+    of a run's difference, per metric), every other behind by ``others`` on one metric and ahead by as much
+    on the other (a trade-off, as Figure 3's grid). Null for "reproduced": a rival equal on both, (0, 0);
+    null for "not reproduced": a rival equal on one and ahead on the other, at the edge of dominance."""
+    def draw(rng, reps):
+        k = PARETO_SETTINGS - 1
+        shift = np.tile(np.array([others, -others]), (k, 1))
+        shift[0] = rival
+        shape = (reps, k, PARETO_RUNS, 2)
+        shared = noise(distribution, rng, (reps, 1, PARETO_RUNS, 2))
+        chosen = shared + noise(distribution, rng, shape)
+        other = shared + noise(distribution, rng, shape) - (shift * math.sqrt(2.0))[None, :, None, :]
+        tested = dominance(chosen, other)
+        return _reading(tested.p_for, tested.p_against)
+    return Case("pareto", PARETO_RUNS, PARETO_SETTINGS - 1, distribution, truth, guards, float(np.max(rival)), draw)
+
+
 def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
     """Every row of the calibration table."""
     found = []
@@ -347,6 +382,11 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
         found += [bca_case(n, d, "null", "reproduced", 1, 0.0) for d in distributions]
         found += [bca_case(n, d, "null", "not reproduced", 9, 0.0) for d in distributions]
     found += [best_case("normal", "null", "not reproduced", 0.14, control=True)]
+    for d in distributions:
+        found += [growth_case(d, "null", "reproduced", GROWTH_BOUND), growth_case(d, "null", "not reproduced", GROWTH_BOUND),
+                  growth_case(d, "effect", "reproduced", 1.0)]
+        found += [pareto_case(d, "null", "reproduced", (0.0, 0.0)), pareto_case(d, "null", "not reproduced", (0.0, 1.0)),
+                  pareto_case(d, "effect", "reproduced", (-1.0, -1.0))]
     return found
 
 

@@ -571,7 +571,8 @@ class Growth(ClaimTest):
         slope = log_log_slope(x[kept], values[kept], spec["at_most"])
         what = f"{spec['method']}: growth exponent of {spec['metric']} in {spec['x']} ({len(set(x[kept]))} values)"
         verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec['x']}^{spec['at_most']:g}")
-        shown = Estimate(slope.value, slope.low, slope.high, slope.points, "least squares on logs, t, 90% CI")
+        shown = Estimate(float(slope.value), float(slope.low), float(slope.high), slope.points,
+                         "least squares on logs, t, 90% CI")
         return [Check(what, verdict, shown, reference=float(spec["at_most"]), paper=float(spec["at_most"]),
                       timed=quantity(spec["metric"]).machine_dependent)]
 

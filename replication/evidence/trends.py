@@ -20,48 +20,55 @@ from replication.evidence.settings import INFERENCE
 class Slope:
     """The least-squares slope of log(value) on log(x) over every run, with its 90 % t interval (each bound the
     one-sided 95 % bound) and the one-sided p-values of the true slope lying below (``p_below``) and above
-    (``p_above``) the ``bound`` tested."""
+    (``p_above``) the ``bound`` tested; arrays over leading batch axes."""
 
-    value: float
-    low: float
-    high: float
-    p_below: float
-    p_above: float
+    value: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    p_below: np.ndarray
+    p_above: np.ndarray
     points: int
 
 
 def log_log_slope(x, values, bound: float) -> Slope:
-    """The growth exponent b of ``values`` ~ a x^b (ordinary least squares on logs, one point per run), tested
-    against ``bound``: b < bound (p_below) and b > bound (p_above), Student's t with n - 2 degrees of freedom
-    (scipy.stats.linregress's standard error)."""
-    x, values = np.log(np.asarray(x, dtype=float)), np.log(np.asarray(values, dtype=float))
-    n = len(x)
-    fit = stats.linregress(x, values)
-    if n < 3 or not np.isfinite(fit.stderr) or fit.stderr == 0:
-        return Slope(float(fit.slope), np.nan, np.nan, np.nan, np.nan, n)
-    t = (fit.slope - bound) / fit.stderr
-    half = stats.t.ppf(1 - INFERENCE.alpha, n - 2) * fit.stderr
-    return Slope(float(fit.slope), float(fit.slope - half), float(fit.slope + half), float(stats.t.cdf(t, n - 2)),
-                 float(stats.t.sf(t, n - 2)), n)
+    """The growth exponent b of ``values`` ~ a x^b (ordinary least squares on logs, one point per run; last
+    axis: the points, leading axes a batch), tested against ``bound``: b < bound (p_below) and b > bound
+    (p_above), Student's t with n - 2 degrees of freedom and the slope's usual standard error (what
+    scipy.stats.linregress gives for one set); undefined (NaN) where the points fit a line exactly."""
+    x, y = np.log(np.asarray(x, dtype=float)), np.log(np.asarray(values, dtype=float))
+    n = y.shape[-1]
+    dx = x - x.mean(axis=-1, keepdims=True)
+    sxx = (dx ** 2).sum(axis=-1)
+    slope = (dx * y).sum(axis=-1) / sxx
+    residual = y - y.mean(axis=-1, keepdims=True) - slope[..., None] * dx
+    se = np.sqrt((residual ** 2).sum(axis=-1) / max(n - 2, 1) / sxx)
+    defined = (n > 2) & (se > 1e-12 * np.maximum(1.0, np.abs(slope)))
+    with np.errstate(all="ignore"):
+        t = np.where(defined, (slope - bound) / se, np.nan)
+        half = stats.t.ppf(1 - INFERENCE.alpha, max(n - 2, 1)) * se
+    return Slope(slope, np.where(defined, slope - half, np.nan), np.where(defined, slope + half, np.nan),
+                 stats.t.cdf(t, max(n - 2, 1)), stats.t.sf(t, max(n - 2, 1)), n)
 
 
 @dataclass(frozen=True)
 class Dominance:
-    """A chosen setting against one other, on two metrics where lower is better (paired by run): p_for, that
+    """A chosen setting against another, on two metrics where lower is better (paired by run): p_for, that
     the chosen one is better on at least one of them (the smaller one-sided p-value, Bonferroni-doubled);
     p_against, that the other is better on both (the larger of its two one-sided p-values: an
-    intersection-union test)."""
+    intersection-union test); arrays over leading batch axes."""
 
-    p_for: float
-    p_against: float
-    gains: tuple[float, float]  # the other minus the chosen, mean over runs, per metric (> 0: the chosen is better)
+    p_for: np.ndarray
+    p_against: np.ndarray
+    gains: np.ndarray  # the other minus the chosen, mean over runs, per metric (> 0: the chosen is better)
 
 
 def dominance(chosen, other) -> Dominance:
-    """``chosen`` and ``other``: runs x 2 arrays of two lower-is-better metrics on the same data (common random
-    numbers), rows paired."""
-    gain = np.asarray(other, dtype=float) - np.asarray(chosen, dtype=float)  # runs x metrics
-    tested = mean_test(gain.T)  # per metric
-    p_for = float(min(1.0, 2 * np.nanmin(tested.p_above))) if np.isfinite(tested.p_above).any() else np.nan
-    p_against = float(np.max(tested.p_below)) if np.isfinite(tested.p_below).all() else np.nan
-    return Dominance(p_for, p_against, (float(tested.value[0]), float(tested.value[1])))
+    """``chosen`` and ``other``: (batch...) x runs x 2 arrays of two lower-is-better metrics on the same data
+    (common random numbers), rows paired."""
+    gain = np.asarray(other, dtype=float) - np.asarray(chosen, dtype=float)
+    tested = mean_test(np.swapaxes(gain, -1, -2))  # per metric: (batch...) x 2
+    with np.errstate(all="ignore"):
+        p_for = np.minimum(1.0, 2 * np.min(np.where(np.isnan(tested.p_above), np.inf, tested.p_above), axis=-1))
+    p_for = np.where(np.isfinite(p_for), p_for, np.nan)
+    p_against = np.max(tested.p_below, axis=-1)  # NaN where either metric's test is undefined
+    return Dominance(p_for, p_against, tested.value)
