@@ -5,6 +5,7 @@ import pandas as pd
 import pytest
 from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
+from scipy import stats
 
 from conftest import PROJECT_ROOT, typed
 
@@ -13,6 +14,7 @@ from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
 from replication.evidence.claims import Check, ClaimTest, Reading, Result, load_papers
 from replication.evidence.published import load_published
+from replication.evidence.settings import INFERENCE
 
 PUBLISHED = resolve("../shared/reference/published_values.csv")
 PAPERS = load_papers()
@@ -276,3 +278,97 @@ def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
     result = Result.of(ClaimTest.of({"test": "cells", "tables": ["t3"]}, EXPERIMENT).checks(records, {"t3": table}))
     assert result.verdict.outcome is Outcome.NOT_REPRODUCED  # 12 of 40 failed: [0.18, 0.45], medium, not good
     assert result.deciding.estimate.value == 0.3 and "(ours: medium)" in result.deciding.what
+
+
+def test_the_deciding_check_is_the_strongest_evidence_however_small_its_p_value():
+    def against(p: float, what: str) -> Check:
+        return Check(what, Verdict(Outcome.NOT_REPRODUCED, "", 1.0, p), Estimate(1.0, 0.5, 1.5, 10, ""))
+
+    assert Result.of([against(1e-20, "weaker"), against(1e-30, "stronger")]).deciding.what == "stronger"
+    # Holm's running maximum ties the two (2 x 1e-3 and 1.2e-3 both become 2e-3): the smaller p-value decides
+    assert Result.of([against(1.2e-3, "weaker"), against(1e-3, "stronger")]).deciding.what == "stronger"
+    # on runs: A is worse than B by 1.5, B than C by 3 (p about 1e-23 and 1e-30, both 0 as 1 - p_above)
+    records = _records({"A": 1.5, "B": 0.0, "C": -3.0})
+    result = Result.of(ClaimTest.of({"test": "order", "metric": "rmse", "order": ["A", "B", "C"]}, EXPERIMENT)
+                       .checks(records, {}))
+    assert result.verdict.outcome is Outcome.NOT_REPRODUCED and result.deciding.what == "B - C at N=1"
+    runs = records.pivot(index="repetition", columns="method", values="rmse")
+    scipy = [stats.ttest_1samp(runs[b] - runs[w], 0.0, alternative="greater").pvalue for b, w in [("A", "B"), ("B", "C")]]
+    assert 0 < scipy[1] < scipy[0] < 1e-16
+    assert [c.verdict.p_against for c in result.checks] == pytest.approx(scipy, rel=1e-6)
+    assert result.verdict.p_against == pytest.approx(2 * scipy[1], rel=1e-6)  # Holm across the two checks
+
+
+def test_a_reading_names_the_checks_it_could_not_test():
+    def check(what, outcome, why=""):
+        return Check(what, Verdict(outcome, why), Estimate(1.0, 0.5, 1.5, 10, ""))
+
+    yes = check("A - B", Outcome.REPRODUCED)
+    result = Result.of([yes, yes, check("A - C", Outcome.NOT_TESTABLE, "too few runs (4)"),
+                        check("A - D", Outcome.NOT_TESTABLE)])
+    assert result.verdict.outcome is Outcome.REPRODUCED
+    assert result.verdict.why.startswith("2 of 2 testable checks hold; 2 not testable: A - C (too few runs (4)), "
+                                         "A - D; A - B: ")
+    assert Result.of([yes, yes]).verdict.why.startswith("2 of 2 checks hold; A - B: ")  # all testable: said plainly
+
+
+def test_a_check_with_an_allowance_shows_the_raw_difference_and_the_allowance_apart():
+    """"B takes no more than 10 % longer than A": B is 5 % slower, 0.5 of A's 10; the test allows 1.0."""
+    rng = np.random.default_rng(3)
+    base = rng.normal(10.0, 1.0, 20)
+    a, b = base, base + 0.5 + 0.1 * rng.standard_normal(20)
+    records = typed(pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
+                                   "ms_per_step": v[r]} for m, v in (("A", a), ("B", b)) for r in range(20)]))
+    spec = {"test": "order", "metric": "ms_per_step", "order": ["B", "A"], "tolerance": 0.1, "unit": " ms"}
+    (check,) = ClaimTest.of(spec, EXPERIMENT).checks(records, {})
+    interval = stats.ttest_1samp(b - a, 0.0).confidence_interval(1 - 2 * INFERENCE.alpha)
+    assert check.estimate.value == pytest.approx(np.mean(b - a))  # the raw difference, not less the allowance
+    assert (check.estimate.low, check.estimate.high) == pytest.approx((interval.low, interval.high))
+    allowed = 0.1 * a.mean()
+    assert check.reference == pytest.approx(allowed)  # the claim's line: slower by at most the allowance
+    assert check.verdict.outcome is Outcome.REPRODUCED
+    assert check.verdict.p_for == pytest.approx(stats.ttest_1samp(b - a, allowed, alternative="less").pvalue)
+    raw = np.mean(b - a)
+    assert check.verdict.why.startswith(f"{raw:+.3g} ms ({raw / a.mean():+.0%}), allowed +10% = {allowed:+.3g} ms: ")
+    higher = records.assign(mean_ess=-records["ms_per_step"])  # higher is better: B may be lower by 10 %
+    (check,) = ClaimTest.of({**spec, "metric": "mean_ess", "unit": ""}, EXPERIMENT).checks(higher, {})
+    assert check.estimate.value == pytest.approx(-raw) and check.reference == pytest.approx(-allowed)
+    assert f"allowed -10% = {-allowed:+.3g}: " in check.verdict.why
+
+
+def test_each_check_shows_the_interval_of_the_level_it_names():
+    """A check's interval is the 90 % interval of the one-sided tests that decided it; a published cell's, its
+    table's 95 % interval (its two-sided test at 5 %): the number says which, and the interval is that."""
+    from replication.evidence.tables.improvement import Improvement
+
+    records = _records({"A": 0.0, "B": 0.2})
+    runs = records.pivot(index="repetition", columns="method", values="rmse")
+    (order,) = ClaimTest.of({"test": "order", "metric": "rmse", "order": ["A", "B"]}, EXPERIMENT).checks(records, {})
+    ninety = stats.ttest_1samp(runs["A"] - runs["B"], 0.0).confidence_interval(0.90)
+    assert (order.estimate.low, order.estimate.high) == pytest.approx((ninety.low, ninety.high))
+    assert order.estimate.level == pytest.approx(0.90) and order.number.endswith(" (90% CI)")
+    (bound,) = ClaimTest.of({"test": "threshold", "metric": "rmse", "method": "A", "condition": "N=1",
+                             "at_most": 6.0}, EXPERIMENT).checks(records, {})
+    ninety = stats.ttest_1samp(runs["A"], 6.0).confidence_interval(0.90)
+    assert (bound.estimate.low, bound.estimate.high) == pytest.approx((ninety.low, ninety.high))
+    assert bound.number.endswith(" (90% CI)")
+    sizes = typed(records[["method", "data_condition", "repetition", "rmse"]].assign(  # a growth exponent's too
+        condition=records["repetition"].map(lambda r: f"N={4 + r}")))
+    (growth,) = ClaimTest.of({"test": "growth", "method": "A", "metric": "rmse", "x": "N", "at_most": 1.0},
+                             EXPERIMENT).checks(sizes, {})
+    a = sizes[sizes["method"] == "A"]
+    fit = stats.linregress(np.log(4.0 + a["repetition"]), np.log(a["rmse"]))
+    assert growth.estimate.high == pytest.approx(fit.slope + stats.t.ppf(0.95, len(a) - 2) * fit.stderr)
+    assert growth.number.endswith(" (90% CI)")
+    published = pd.DataFrame({"paper": ["p"], "table": ["1"], "experiment": ["s"], "method": ["B vs A"],
+                              "metric": ["rmse_improvement"], "condition": [""], "value": ["1.8"], "unit": ["%"],
+                              "note": [""], "number": [1.8]})
+    spec = {"name": "gain", "kind": "improvement", "paper_table": "1", "metric": "rmse",
+            "paper_metric": "rmse_improvement", "baseline": "B", "method": "A", "tolerance_pp": 1.0}
+    table = Improvement(spec, {"paper": "p", "methods": {"A": {}, "B": {}}}, published).build(records)
+    (cell,) = ClaimTest.of({"test": "cells", "tables": ["gain"]}, EXPERIMENT).checks(records, {"gain": table})
+    gain = 100 * (runs["B"] - runs["A"]) / runs["B"].mean()
+    ninety_five = stats.ttest_1samp(gain, 0.0).confidence_interval(INFERENCE.level)
+    assert (cell.estimate.low, cell.estimate.high) == pytest.approx((ninety_five.low, ninety_five.high))
+    assert cell.number.endswith(" (95% CI)")
+    assert "(" not in Check("x", Verdict(Outcome.REPRODUCED), Estimate(1.0, np.nan, np.nan, 5, "")).number  # no interval

@@ -126,3 +126,27 @@ def test_best_test_pairs_each_competitor_over_the_sequences():
     assert found.p_for.shape == (2,)
     expected = stats.ttest_rel(per_sequence[:, 0], per_sequence[:, 2], alternative="greater").pvalue
     assert found.p_for[1] == pytest.approx(expected)
+
+
+def test_both_tails_are_computed_directly_so_tiny_p_values_keep_their_order():
+    # differences far below zero: p_below is about 1e-25 and 1e-19, which 1 - p_above would round to 0
+    steep, gentle = np.linspace(-10.1, -9.9, 12), np.linspace(-10.5, -9.5, 12)
+    for values in (steep, gentle):
+        found = mean_test(values)
+        t = values.mean() / (values.std(ddof=1) / np.sqrt(len(values)))
+        assert found.p_below == pytest.approx(stats.t.cdf(t, len(values) - 1), rel=1e-9)
+        assert found.p_below == pytest.approx(stats.ttest_1samp(values, 0.0, alternative="less").pvalue, rel=1e-6)
+        assert 0 < found.p_below < 1e-16 and found.p_above == pytest.approx(1.0)
+        assert mean_test(-values).p_above == pytest.approx(found.p_below, rel=1e-9)  # the mirror image, same tail
+    assert 0 < mean_test(steep).p_below < mean_test(gentle).p_below  # still ordered, not both 0
+
+
+def test_a_yes_no_sizes_tails_are_both_direct():
+    def size(wins: int, paper: Effect):  # of 100 runs, those only the claimed-better method got right
+        return order_test(np.r_[np.ones(wins), np.zeros(100 - wins)], np.zeros(100), False, binary=True,
+                          paper=paper).size
+
+    few = size(2, Effect(0.95, 0.05))  # against the paper's gap of 0.9
+    assert few.p_below == pytest.approx(stats.binom.cdf(2, 100, 0.9), rel=1e-9) and 0 < few.p_below < 1e-90
+    many = size(95, Effect(0.75, 0.25))  # against 0.5: the upper tail is the tiny one, 0 as 1 - cdf
+    assert many.p_above == pytest.approx(stats.binom.sf(95, 100, 0.5), rel=1e-9) and 0 < many.p_above < 1e-16

@@ -31,7 +31,7 @@ import yaml
 from replication.evidence.comparisons import Effect, OrderTest, best_test, order_test
 from replication.evidence.inference import Test, mean_test, proportion_test, said_p, sign_test
 from replication.evidence.quantities import quantity
-from replication.evidence.statistics import Estimate
+from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR
@@ -127,7 +127,11 @@ class Check:
 
     @property
     def number(self) -> str:
-        return "" if self.estimate is None else f"{self.estimate}{self.unit}"
+        """The estimate with its interval and the interval's level: '0.0266 [0.0243, 0.029] ms (90% CI)'."""
+        e = self.estimate
+        if e is None:
+            return ""
+        return f"{e}{self.unit}" + (f" ({said_level(e.level)})" if e.defined else "")
 
     @property
     def p_values(self) -> tuple[float, float]:
@@ -152,8 +156,9 @@ class Result:
     def of(cls, checks: list[Check]) -> "Result":
         """The reading's verdict by :func:`~replication.evidence.verdict.decide`: not reproduced where some
         check's evidence against the claim survives Holm across the testable checks, reproduced where every
-        testable check holds at 5 %, else inconclusive; not testable where no check is (with the first
-        check's reason).  A check's own verdict is re-stated where Holm changes it."""
+        testable check holds at 5 % (the why names those that are not testable), else inconclusive; not
+        testable where no check is (with the first check's reason).  A check's own verdict is re-stated where
+        Holm changes it."""
         if not checks:
             return cls(Verdict(Outcome.NOT_TESTABLE, "no runs to test it on"))
         p_for, p_against = np.array([c.p_values for c in checks]).T
@@ -163,14 +168,21 @@ class Result:
         if outcome is Outcome.NOT_TESTABLE:
             return cls(Verdict(Outcome.NOT_TESTABLE, checks[0].verdict.why), tuple(checks), checks[0])
         testable = [i for i, c in enumerate(checks) if c.verdict.outcome is not Outcome.NOT_TESTABLE]
+        evidence = np.nan_to_num(p_against, nan=1.0)  # breaks ties: Holm's running maximum, p_for rounded to 1
         if outcome is Outcome.NOT_REPRODUCED:
-            i = min((i for i in testable if checks[i].verdict.outcome is outcome), key=lambda i: adjusted[i])
-        else:  # the weakest check: the largest p-value for the claim
-            i = max(testable, key=lambda i: np.nan_to_num(p_for[i], nan=1.0))
+            i = min((i for i in testable if checks[i].verdict.outcome is outcome),
+                    key=lambda i: (adjusted[i], evidence[i]))
+        else:  # the weakest check: the largest p-value for the claim, then the most evidence against it
+            i = max(testable, key=lambda i: (np.nan_to_num(p_for[i], nan=1.0), -evidence[i]))
         deciding = checks[i]
+        untestable = [c for c in checks if c.verdict.outcome is Outcome.NOT_TESTABLE]  # the rule passes over them
         held = sum(c.verdict.outcome is Outcome.REPRODUCED for c in checks)
+        tally = f"{held} of {len(testable)} {'testable ' if untestable else ''}checks hold"
+        if untestable:
+            tally += f"; {len(untestable)} not testable: " + ", ".join(
+                f"{c.shown} ({c.verdict.why})" if c.verdict.why else c.shown for c in untestable)
         said = "; ".join(filter(None, [deciding.number, deciding.verdict.why]))
-        why = f"{held} of {len(testable)} checks hold; {deciding.shown}" + (f": {said}" if said else "")
+        why = f"{tally}; {deciding.shown}" + (f": {said}" if said else "")
         against = adjusted[i] if outcome is Outcome.NOT_REPRODUCED else p_against[i]  # what decided it
         return cls(Verdict(outcome, why, _finite(p_for[i]), _finite(against)), tuple(checks), deciding)
 
@@ -255,9 +267,13 @@ class Order(ClaimTest):
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
                     paper = self.effect(a, b, condition)
                     verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
+                    # the line the difference better - worse is tested against: worse by at most the allowance
+                    line = allowed * scale * (1 if kind.lower_is_better else -1)
+                    if allowed and verdict.outcome is not Outcome.NOT_TESTABLE:
+                        verdict = _allowing(verdict, difference, line, paired["baseline"].mean() * scale, unit)
                     per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
                     work = _work(records, (a, b), condition) if kind.machine_dependent else ""  # beside a time
-                    found.append(Check(what, verdict, difference, unit, 0.0, per_run, work,
+                    found.append(Check(what, verdict, difference, unit, line, per_run, work,
                                        _shown_gap(paper), kind.machine_dependent))
         return found
 
@@ -347,7 +363,8 @@ def _work(records: pd.DataFrame, methods: tuple[str, ...], condition: str) -> st
 def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allowed: float,
                  paper: Effect | None) -> tuple[Verdict, Estimate]:
     """One pair's verdict (before the reading's Holm) and the paired difference better - worse shown with
-    it, in the claim's units (``scale``)."""
+    it, in the claim's units (``scale``): the raw difference, the margin ``allowed`` in the claim's favour
+    (in the runs' units) tested but not shown in it."""
     runs = len(better)
     binary = kind.proportion
     unit = kind.high * scale if binary else scale  # yes/no outcomes are tested as 0 or 1
@@ -355,7 +372,7 @@ def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allo
     as_tested = Effect(paper.better / unit, paper.worse / unit, paper.kind) if paper else None
     tested = order_test(better * scale / unit, worse * scale / unit, kind.lower_is_better, binary,
                         allowed * scale / unit, as_tested)
-    difference = _shown(tested.gain, unit * (-1 if kind.lower_is_better else 1), runs)
+    difference = _shown(tested.gain, unit * (-1 if kind.lower_is_better else 1), runs, allowed * scale / unit)
     few = too_few(runs)
     if few:
         return few, difference
@@ -367,11 +384,22 @@ def _shown_gap(paper: Effect | None) -> float | None:
     return None if paper is None or paper.kind != "difference" else paper.better - paper.worse
 
 
-def _shown(test: Test, factor: float, runs: int) -> Estimate:
+def _shown(test: Test, factor: float, runs: int, allowed: float = 0.0) -> Estimate:
     """A gain's test as the difference better - worse in the claim's units (``factor`` flips the sign where
-    lower is better)."""
-    ends = sorted([float(test.low) * factor, float(test.high) * factor])
-    return Estimate(float(test.value) * factor, *ends, runs, f"paired {test.method}, 90% CI")
+    lower is better), with the test's 90 % interval; ``allowed``, the margin the test added to the gain in
+    the claim's favour, taken back out: the raw difference."""
+    ends = sorted([(float(test.low) - allowed) * factor, (float(test.high) - allowed) * factor])
+    return Estimate((float(test.value) - allowed) * factor, *ends, runs, f"paired {test.method}",
+                    1 - 2 * INFERENCE.alpha)
+
+
+def _allowing(verdict: Verdict, difference: Estimate, line: float, baseline: float, unit: str) -> Verdict:
+    """A check's verdict with the raw difference and the allowance it was tested against said apart, before
+    its own why: '+0.0266 ms (+55%), allowed +10% = +0.00482 ms: the other way round, p < 1e-4'
+    (``line``: the allowance as a difference better - worse; ``baseline``: the beaten method's mean)."""
+    raw, relative = difference.value, difference.value / abs(baseline)
+    said = f"{raw:+.3g}{unit} ({relative:+.0%}), allowed {line / abs(baseline):+.0%} = {line:+.3g}{unit}"
+    return replace(verdict, why=f"{said}: {verdict.why}" if verdict.why else said)
 
 
 def _order_verdict(tested: OrderTest, paper: Effect | None, unit: float, binary: bool) -> Verdict:
@@ -445,7 +473,7 @@ class Threshold(ClaimTest):
             test = (sign_test if spec.get("statistic") == "median" else mean_test)(values, bound)
             factor = 1.0
         shown = Estimate(float(test.value) * factor, float(test.low) * factor, float(test.high) * factor,
-                         len(values), f"{test.method}, 90% CI")
+                         len(values), test.method, 1 - 2 * INFERENCE.alpha)
         what = f"{spec['method']} {spec.get('statistic', 'mean')} {metric} {'>=' if above else '<='} {bound:g}"
         p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
         verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
@@ -505,7 +533,7 @@ class Best(ClaimTest):
             what = f"{method} - {other}, mean {metric} over {len(found.sequences)} sequences x {found.runs} run(s)"
             difference = Estimate(sign * float(tested.gain.value[j]),
                                   *sorted([sign * float(tested.gain.low[j]), sign * float(tested.gain.high[j])]),
-                                  len(found.sequences), "sequence-level paired t, 90% CI")
+                                  len(found.sequences), "sequence-level paired t", 1 - 2 * INFERENCE.alpha)
             if caveat:
                 verdict = Verdict(Outcome.NOT_TESTABLE, f"{caveat}; {description}")
             else:
@@ -572,7 +600,7 @@ class Growth(ClaimTest):
         what = f"{spec['method']}: growth exponent of {spec['metric']} in {spec['x']} ({len(set(x[kept]))} values)"
         verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec['x']}^{spec['at_most']:g}")
         shown = Estimate(float(slope.value), float(slope.low), float(slope.high), slope.points,
-                         "least squares on logs, t, 90% CI")
+                         "least squares on logs, t", 1 - 2 * INFERENCE.alpha)
         return [Check(what, verdict, shown, reference=float(spec["at_most"]), paper=float(spec["at_most"]),
                       timed=quantity(spec["metric"]).machine_dependent)]
 

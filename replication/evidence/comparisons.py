@@ -103,9 +103,9 @@ def _binary_size(gain: np.ndarray, paper_gain: float) -> Test:
     the runs the claimed-better method alone got right are too few for a rate p10 >= ``paper_gain``."""
     n = gain.shape[-1]
     wins = (gain > 0).sum(axis=-1)
-    p_below = stats.binom.cdf(wins, n, min(paper_gain, 1.0))
+    p_below, p_above = (tail(wins, n, min(paper_gain, 1.0)) for tail in (stats.binom.cdf, stats.binom.sf))
     mean = gain.mean(axis=-1)
-    return Test(mean, np.full(mean.shape, np.nan), np.full(mean.shape, np.nan), 1.0 - p_below, p_below, n,
+    return Test(mean, np.full(mean.shape, np.nan), np.full(mean.shape, np.nan), p_above, p_below, n,
                 "exact binomial bound")
 
 

@@ -60,9 +60,11 @@ def mean_test(values, reference=0.0) -> Test:
     with np.errstate(all="ignore"):
         t = np.where(spread, (mean - reference) / se, np.nan)
         half = stats.t.ppf(1 - INFERENCE.alpha, n - 1) * se if n > 1 else np.nan
+    # each tail directly, never one as 1 minus the other (which rounds a tail under 1e-16 to 0)
     p_above = stats.t.sf(t, n - 1) if n > 1 else np.full(np.shape(t), np.nan)
+    p_below = stats.t.cdf(t, n - 1) if n > 1 else np.full(np.shape(t), np.nan)
     low, high = np.where(spread, mean - half, np.nan), np.where(spread, mean + half, np.nan)
-    return Test(mean, low, high, p_above, np.where(np.isfinite(t), 1.0 - p_above, np.nan), n, "t")
+    return Test(mean, low, high, p_above, p_below, n, "t")
 
 
 def sign_test(values, reference=0.0) -> Test:

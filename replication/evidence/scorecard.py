@@ -137,7 +137,7 @@ def cell_tallies(cells: pd.DataFrame) -> dict[str, str]:
 
 
 def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: dict[str, str]) -> pd.DataFrame:
-    """``reports/claims.csv``: one row per claim with its verdict, deciding number and interval, runs,
+    """``reports/claims.csv``: one row per claim with its verdict, deciding number, interval and its level, runs,
     why, robustness across readings, and the published cells it owns (``cells``: the summary of every
     cell, with its claim)."""
     owned = cells["claim"].value_counts()
@@ -151,7 +151,9 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
                 "quote": row.claim.quote.text, "quote_english": row.claim.quote.english,
                 "verdict": row.verdict.outcome.value, "reason": row.verdict.why,
                 "number": estimate.value if estimate else None, "ci_low": estimate.low if estimate else None,
-                "ci_high": estimate.high if estimate else None, "runs": estimate.runs if estimate else None,
+                "ci_high": estimate.high if estimate else None,
+                "level": estimate.level if estimate and estimate.defined else None,  # the interval's coverage
+                "runs": estimate.runs if estimate else None,
                 "deciding": deciding.shown if deciding else "",
                 "at_equal_cost": "; ".join(f"{r.verdict.outcome.value} at {r.reading.compared_at}"
                                            for r in row.at_equal_cost),

@@ -16,7 +16,7 @@ these intervals are what a reader sees beside them.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
@@ -27,13 +27,16 @@ from replication.evidence.settings import INFERENCE
 
 @dataclass(frozen=True)
 class Estimate:
-    """A statistic over ``runs`` runs with its 95% interval [low, high] (NaN where undefined) and how it was made."""
+    """A statistic over ``runs`` runs with its interval [low, high] (NaN where undefined), how it was made and
+    the interval's coverage ``level`` (the inference setting's, 95 %, unless made otherwise: a check's is the
+    90 % interval of the one-sided tests that decided it)."""
 
     value: float
     low: float
     high: float
     runs: int
     method: str
+    level: float = field(default_factory=lambda: INFERENCE.level)
 
     @property
     def defined(self) -> bool:
@@ -46,10 +49,11 @@ class Estimate:
         """The interval with both half-widths times ``factor`` (still inside the quantity's range)."""
         low = max(self.value - factor * (self.value - self.low), quantity.low)
         high = min(self.value + factor * (self.high - self.value), quantity.high)
-        return Estimate(self.value, low, high, self.runs, f"{self.method}, widened x{factor:.2f}")
+        return Estimate(self.value, low, high, self.runs, f"{self.method}, widened x{factor:.2f}", self.level)
 
     def scaled(self, factor: float) -> "Estimate":
-        return Estimate(self.value * factor, self.low * factor, self.high * factor, self.runs, self.method)
+        return Estimate(self.value * factor, self.low * factor, self.high * factor, self.runs, self.method,
+                        self.level)
 
     def __str__(self) -> str:
         if not math.isfinite(self.value):
@@ -57,6 +61,11 @@ class Estimate:
         if not self.defined:
             return f"{self.value:.4g}"
         return f"{self.value:.4g} [{self.low:.4g}, {self.high:.4g}]"
+
+
+def said_level(level: float) -> str:
+    """An interval's coverage as a reader sees it beside the interval: '90% CI'."""
+    return f"{100 * level:g}% CI"
 
 
 def _finite(values) -> np.ndarray:

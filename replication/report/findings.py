@@ -41,6 +41,7 @@ import jinja2
 import pandas as pd
 
 from replication.evidence.claims import Paper, load_papers
+from replication.evidence.statistics import said_level
 from replication.evidence.summary import load_summaries
 from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, PROFILE, sha256
@@ -62,11 +63,12 @@ def number(value) -> str:
     return f"{value:,.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
 
 
-def estimate(value, low, high) -> str:
-    """'value [low, high]', or the value alone where the interval is not defined."""
+def estimate(value, low, high, level=None) -> str:
+    """'value [low, high]', with the interval's level where given ('value [low, high] (90% CI)'), or the
+    value alone where the interval is not defined."""
     if any(v is None or not math.isfinite(v) for v in (low, high)):
         return number(value)
-    return f"{number(value)} [{number(low)}, {number(high)}]"
+    return f"{number(value)} [{number(low)}, {number(high)}]" + (f" ({said_level(level)})" if level else "")
 
 
 def duration(minutes: float) -> str:
@@ -172,13 +174,13 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
 
     def scorecard() -> str:
         rows = claims[claims["paper"] == paper]
-        header = ["claim", "verdict", "deciding", "estimate [90% interval]", "runs", "under every reading"]
+        header = ["claim", "verdict", "deciding", "estimate [interval]", "runs", "under every reading"]
         return markdown_table(header,
-                              [[f"`{c}`: {t}", f"**{v}**", d or "", estimate(n, lo, hi) if n == n else "",
+                              [[f"`{c}`: {t}", f"**{v}**", d or "", estimate(n, lo, hi, _cell(lv)) if n == n else "",
                                 number(r) if r == r else "", rb or ""]
-                               for c, t, v, d, n, lo, hi, r, rb in rows[
-                                   ["claim_id", "claim", "verdict", "deciding", "number", "ci_low", "ci_high", "runs",
-                                    "robustness"]].itertuples(index=False)])
+                               for c, t, v, d, n, lo, hi, lv, r, rb in rows[
+                                   ["claim_id", "claim", "verdict", "deciding", "number", "ci_low", "ci_high", "level",
+                                    "runs", "robustness"]].itertuples(index=False)])
 
     def cells() -> str:
         rows = drawn.cells[drawn.cells["paper"] == paper].fillna("")

@@ -51,7 +51,7 @@ SUMMARY_COLUMNS = {  # the summary's columns as printed: heading -> how wide it 
     "paper": 10, "table": 5, "experiment / condition": 22, "method": 20, "metric": 21, "paper value": 18,
     "ours (95% CI)": 34, "verdict or reason": 60, "claim": 26,
 }
-SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (90% CI)": 30, "why": 60, "readings": 40}
+SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (its interval)": 30, "why": 60, "readings": 40}
 
 
 def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path:
@@ -134,7 +134,7 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
     return pd.DataFrame({
         "claim": [f"{r.claim.text} ({r.claim.where})" for r in rows],
         "verdict": [r.verdict.outcome.value for r in rows],
-        "deciding number (90% CI)": [r.primary.deciding.number if r.primary.deciding else "" for r in rows],
+        "deciding number (its interval)": [r.primary.deciding.number if r.primary.deciding else "" for r in rows],
         "why": ["; ".join(filter(None, [r.verdict.why, tallies.get(r.claim.id, ""), r.claim.note])) for r in rows],
         "readings": [r.primary.reading.name + ("" if len(r.results) == 1 and r.multiverse is None
                                                else f"; {r.robustness}") for r in rows],

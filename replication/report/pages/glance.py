@@ -21,7 +21,7 @@ from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
 from replication.evidence.claims import Check, Paper  # noqa: E402
 from replication.evidence.scorecard import ClaimRow  # noqa: E402
-from replication.evidence.statistics import Estimate  # noqa: E402
+from replication.evidence.statistics import Estimate, said_level  # noqa: E402
 from replication.evidence.verdict import Outcome  # noqa: E402
 from replication.report.figures.style import OUTCOME_COLOURS  # noqa: E402
 from replication.report.pages.recorded import recorded  # noqa: E402
@@ -39,7 +39,7 @@ def relative(check: Check | None) -> Estimate | None:
     if not (math.isfinite(paper) and paper != 0 and math.isfinite(e.value)):
         return None
     ends = sorted([e.low / paper, e.high / paper]) if e.defined else [math.nan, math.nan]
-    return Estimate(e.value / paper, *ends, e.runs, "ours / paper's")
+    return Estimate(e.value / paper, *ends, e.runs, "ours / paper's", e.level)
 
 
 @dataclass(frozen=True)
@@ -145,14 +145,14 @@ def draw(by_paper: dict[str, list[Line]], path: Path) -> Path:
         shown = line.recorded if line.recorded and line.recorded.relative else line.here
         if shown.relative is not None:
             r = shown.relative
-            interval = f" [{r.low:.3g}, {r.high:.3g}]" if math.isfinite(r.low) else ""
+            interval = f" [{r.low:.3g}, {r.high:.3g}] {said_level(r.level)}" if math.isfinite(r.low) else ""
             fig.text(columns["number"], y, f"{r.value:.3g}{interval}", transform=text, fontsize=8, va="center")
         else:
             fig.text(columns["number"], y, "no number quoted", transform=text, fontsize=7, va="center", color="0.45")
         _mark(ax, line.recorded, y - 0.17, filled=True)
         _mark(ax, line.here, y + (0.17 if line.recorded else 0.0), filled=False)
     fig.text(0.01, 0.12 / fig.get_figheight(), "Filled: the record's runs at the papers' scale; hollow: this report's. "
-             "The bar is the deciding check's 90% interval; an arrow, a value beyond the axis. "
+             "The bar is the deciding check's interval, at the level beside its number; an arrow, a value beyond the axis. "
              "\"every reading\": robust when no open choice of the paper's multiverse moves the verdict.",
              fontsize=7, color="0.3")
     path = Path(path)

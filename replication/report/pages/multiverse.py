@@ -23,6 +23,7 @@ from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import load_published, published_path
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
+from replication.evidence.statistics import said_level
 from replication.paths import resolve
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
@@ -68,8 +69,8 @@ def _tables(name: str, experiment: dict, records: pd.DataFrame, claims: list[Cla
 
 def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> None:
     """A forest plot per claim: the deciding check of its default case, in every universe under the claim's
-    first reading, with its 95% interval, coloured by verdict; the claim's line (the paper's value, a bound
-    or zero difference) dashed."""
+    first reading, with the interval of the test that decided it (its level in the panel's title), coloured by
+    verdict; the claim's line (the paper's value, a bound, zero difference or an allowed margin) dashed."""
     path.unlink(missing_ok=True)  # a figure of runs since recomputed must not outlive them
     shown = [r for r in robustness if _headline(r)]
     if not shown:
@@ -79,7 +80,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
     for ax, claim in zip(axes[:, 0], shown):
         what = _headline(claim)
         first = claim.claim.readings[0].name
-        reference = None  # the claim's line, from its checks (never the previous claim's)
+        reference, level = None, None  # the claim's line and interval level, from its checks (not the last claim's)
         for y, universe in enumerate(multiverse.universes):
             case = next((c for c in claim.cases if c.universe == universe.name and dict(c.picks)[READING] == first),
                         None)
@@ -90,12 +91,13 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
             if check.estimate.defined:
                 ax.plot([check.estimate.low, check.estimate.high], [y, y], color=colour, lw=2)
             ax.plot([check.estimate.value], [y], "o", color=colour)
-            reference = check.reference
+            reference, level = check.reference, check.estimate.level
         if reference is not None:
             ax.axvline(reference, color="0.3", ls="--", lw=1)
         ax.set_yticks(range(rows), [u.name for u in multiverse.universes], fontsize=7)
         ax.invert_yaxis()
-        ax.set_title(f"{claim.claim.id}: {what}", fontsize=8, loc="left")
+        title = f"{claim.claim.id}: {what}" + (f" ({said_level(level)})" if level else "")
+        ax.set_title(title, fontsize=8, loc="left")
         ax.tick_params(axis="x", labelsize=7)
     handles = [plt.Line2D([], [], marker="o", color=colour, ls="", label=outcome)
                for outcome, colour in OUTCOME_COLOURS.items()]
@@ -135,7 +137,7 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
         command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
     figures = ({"name": "readings", "file": "readings.png",
-                "title": "Each claim's deciding number in every universe (95% CI, coloured by verdict)"},)
+                "title": "Each claim's deciding number in every universe (its test's interval, coloured by verdict)"},)
     Summary(multiverse.name, cfg.experiment.get("title", multiverse.name), multiverse.paper, cfg.scale, n_records,
             n_runs, figures=figures if (out / "readings.png").exists() else (),
             multiverse={r.claim.id: r.as_result() for r in robustness}).write(out)
