@@ -10,7 +10,7 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.claims import EQUAL_N, Check, Claim, Reading, Result, load_papers
+from replication.evidence.claims import EQUAL_N, Check, Claim, Quote, Reading, Result, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.robustness import Pairing
 from replication.evidence.schema import Summary
@@ -131,7 +131,7 @@ def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", hel
     return Case(universe, (*picks.items(), (READING, reading)), Result(Verdict(outcome), checks, deciding))
 
 
-CLAIM = Claim("p.c", "p", "A beats B", "Table 1", {}, (Reading("r1", "e", {}),))
+CLAIM = Claim("p.c", "p", "A beats B", Quote("A schlägt B", "A beats B"), "Table 1", {}, (Reading("r1", "e", {}),))
 RUNS = dict(enumerate(np.random.default_rng(4).normal(0.3, 1.0, 10)))
 
 
