@@ -174,13 +174,13 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
 
     def scorecard() -> str:
         rows = claims[claims["paper"] == paper]
-        header = ["claim", "verdict", "deciding", "estimate [interval]", "runs", "under every reading"]
+        header = ["claim", "the paper says", "verdict", "deciding", "estimate [interval]", "runs", "under every reading"]
         return markdown_table(header,
-                              [[f"`{c}`: {t}", f"**{v}**", d or "", estimate(n, lo, hi, _cell(lv)) if n == n else "",
-                                number(r) if r == r else "", rb or ""]
-                               for c, t, v, d, n, lo, hi, lv, r, rb in rows[
-                                   ["claim_id", "claim", "verdict", "deciding", "number", "ci_low", "ci_high", "level",
-                                    "runs", "robustness"]].itertuples(index=False)])
+                              [[f"`{c}`: {t}", f"\u201c{q}\u201d ({w})", f"**{v}**", d or "",
+                                estimate(n, lo, hi, _cell(lv)) if n == n else "", number(r) if r == r else "", rb or ""]
+                               for c, t, q, w, v, d, n, lo, hi, lv, r, rb in rows[
+                                   ["claim_id", "claim", "quote_english", "where", "verdict", "deciding", "number",
+                                    "ci_low", "ci_high", "level", "runs", "robustness"]].itertuples(index=False)])
 
     def cells() -> str:
         rows = drawn.cells[drawn.cells["paper"] == paper].fillna("")
