@@ -163,11 +163,19 @@ def test_holm_keeps_nine_checks_from_calling_a_claim_wrong_on_one_unlucky_check(
     assert "not significant after Holm across 9 checks" in result.checks[0].verdict.why
 
 
-def test_identical_outcomes_decide_nothing_unless_the_paper_quotes_a_size():
-    both_fail = _records({"A": 0.0, "B": 0.0}, metric="tracked_to_end[cle<=20]", noise=0.0)
-    both_fail["tracked_to_end[cle<=20]"] = 0.0
-    verdict = _verdict({"test": "order", "metric": "tracked_to_end[cle<=20]", "order": ["A", "B"]}, both_fail)
-    assert verdict.outcome is Outcome.NOT_TESTABLE and "every run gives the same difference" in verdict.why
+def test_identical_outcomes_decide_nothing_even_against_the_papers_size():
+    """Every run of both methods at the floor: the paper's 95 % against 55 % (its own noise alone would call
+    a gap of 0 short of 40 pp) is not tested: the scene decides nothing about the paper."""
+    metric = "tracked_to_end[cle<=20]"
+    both_fail = _records({"A": 0.0, "B": 0.0}, metric=metric, noise=0.0)
+    both_fail[metric] = 0.0
+    for size in ({}, {"size": {"quoted": {"A": 95, "B": 55}}, "scale": 100}):
+        verdict = _verdict({"test": "order", "metric": metric, "order": ["A", "B"], **size}, both_fail)
+        assert verdict.outcome is Outcome.NOT_TESTABLE
+        assert "every run of both methods at the floor (0 of 20): the scene decides nothing" in verdict.why
+    both_fail[metric] = 1.0
+    assert "at the ceiling (20 of 20)" in _verdict({"test": "order", "metric": metric, "order": ["A", "B"]},
+                                                    both_fail).why
 
 
 def test_a_quoted_size_is_tested_against_ours():

@@ -7,6 +7,7 @@ import pytest
 from scipy import stats
 
 from replication.evidence.comparisons import Effect, best_test, order_test
+from replication.evidence.original import PaperRuns
 from replication.evidence.inference import (
     clopper_pearson, detectable, holm, mean_test, paired_binary_test, proportion_test, sign_test,
 )
@@ -14,6 +15,7 @@ from replication.evidence.settings import INFERENCE
 from replication.evidence.verdict import OUTCOMES, Outcome, decide
 
 RNG = np.random.default_rng(7)
+HUNDRED = PaperRuns(100, True, "100 runs, stated")
 
 
 def test_mean_test_is_scipys_one_sample_t_test_with_its_90_percent_interval():
@@ -100,23 +102,17 @@ def test_order_test_orients_the_gain_and_tests_the_papers_difference():
     better = worse - np.array([0.1, 0.12, 0.08, 0.11, 0.09, 0.1])  # lower is better: better by about 0.1
     found = order_test(better, worse, lower_is_better=True)
     assert found.p_for < 1e-4 and found.gain.value == pytest.approx(0.1)
-    sized = order_test(better, worse, lower_is_better=True, paper=Effect(1.6, 4.2))  # the paper's gain: 2.6
+    sized = order_test(better, worse, lower_is_better=True, paper=Effect(1.6, 4.2, HUNDRED))  # its gain: 2.6
     assert sized.p_against < 1e-4 and sized.p_for < 1e-4  # the sign agrees, the size does not
-    close = order_test(better, worse, lower_is_better=True, paper=Effect(4.1, 4.2))  # the paper's gain: 0.1
+    close = order_test(better, worse, lower_is_better=True, paper=Effect(4.1, 4.2, HUNDRED))  # its gain: 0.1
     assert close.p_against > 0.3
 
 
 def test_a_ratio_is_tested_in_fiellers_linear_form():
     worse = np.array([10.0, 11.0, 9.0, 10.5, 9.5, 10.2, 9.8, 10.1])
     better = 0.5 * worse + np.array([0.1, -0.1, 0.05, -0.05, 0.0, 0.1, -0.1, 0.0])
-    assert order_test(better, worse, True, paper=Effect(0.91, 2.72, "ratio")).p_against < 1e-4  # 0.33 absent
-    assert order_test(better, worse, True, paper=Effect(1.0, 2.0, "ratio")).p_against > 0.1  # 0.5: consistent
-
-
-def test_a_yes_no_size_is_bounded_by_the_runs_only_the_better_method_got_right():
-    better, worse = np.zeros(100), np.zeros(100)  # every pair ties: no direction to test
-    found = order_test(better, worse, False, binary=True, paper=Effect(0.95, 0.55))
-    assert np.isnan(found.p_for) and found.p_against == pytest.approx(stats.binom.cdf(0, 100, 0.4))
+    assert order_test(better, worse, True, paper=Effect(0.91, 2.72, HUNDRED, "ratio")).p_against < 1e-4  # 0.33
+    assert order_test(better, worse, True, paper=Effect(1.0, 2.0, HUNDRED, "ratio")).p_against > 0.1  # 0.5
 
 
 def test_best_test_pairs_each_competitor_over_the_sequences():
@@ -142,11 +138,11 @@ def test_both_tails_are_computed_directly_so_tiny_p_values_keep_their_order():
 
 
 def test_a_yes_no_sizes_tails_are_both_direct():
-    def size(wins: int, paper: Effect):  # of 100 runs, those only the claimed-better method got right
-        return order_test(np.r_[np.ones(wins), np.zeros(100 - wins)], np.zeros(100), False, binary=True,
+    def size(wins: int, runs: int, paper: Effect):  # of ``runs``, those only the claimed-better method got right
+        return order_test(np.r_[np.ones(wins), np.zeros(runs - wins)], np.zeros(runs), False, binary=True,
                           paper=paper).size
 
-    few = size(2, Effect(0.95, 0.05))  # against the paper's gap of 0.9
-    assert few.p_below == pytest.approx(stats.binom.cdf(2, 100, 0.9), rel=1e-9) and 0 < few.p_below < 1e-90
-    many = size(95, Effect(0.75, 0.25))  # against 0.5: the upper tail is the tiny one, 0 as 1 - cdf
-    assert many.p_above == pytest.approx(stats.binom.sf(95, 100, 0.5), rel=1e-9) and 0 < many.p_above < 1e-16
+    few = size(2, 100, Effect(0.95, 0.05, HUNDRED))  # against the paper's gap of 0.9
+    assert 0 < few.p_below < 1e-16 and few.p_above == 1.0
+    many = size(400, 400, Effect(0.6, 0.4, PaperRuns(1000, True, "")))  # the upper tail: 0 as 1 - cdf
+    assert 0 < many.p_above < 1e-40 and many.p_below == 1.0

@@ -29,7 +29,8 @@ import pandas as pd
 import yaml
 
 from replication.evidence.comparisons import Effect, OrderTest, best_test, order_test
-from replication.evidence.inference import Test, mean_test, proportion_test, said_p, sign_test
+from replication.evidence.inference import mean_test, proportion_test, said_p, sign_test
+from replication.evidence.original import runs_behind
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide, too_few
@@ -265,7 +266,7 @@ class Order(ClaimTest):
                         continue
                     allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-                    paper = self.effect(a, b, condition)
+                    paper = self.effect(a, b, condition, len(paired))
                     verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
                     # the line the difference better - worse is tested against: worse by at most the allowance
                     line = allowed * scale * (1 if kind.lower_is_better else -1)
@@ -277,14 +278,19 @@ class Order(ClaimTest):
                                        _shown_gap(paper), kind.machine_dependent))
         return found
 
-    def effect(self, better: str, worse: str, condition: str) -> Effect | None:
+    def effect(self, better: str, worse: str, condition: str, runs: int) -> Effect | None:
         """The paper's numbers for the pair at our ``condition``, matched with its cells as our table named by
-        ``size.table`` matches them (None where ``size`` names none, or a number is missing)."""
+        ``size.table`` matches them (None where ``size`` names none, or a number is missing), with the runs
+        behind them by :func:`~replication.evidence.original.paper_runs` (``runs``: ours): the table's
+        ``paper_runs`` where the paper states them (a user's ``size.runs``)."""
         size = self.spec.get("size")
         if size and "quoted" in size:  # a user's claim quoting its own numbers ({method: number}), no table
             quoted = size["quoted"]
-            return Effect(float(quoted[better]), float(quoted[worse]), size.get("kind", "difference")) \
-                if better in quoted and worse in quoted else None
+            if better not in quoted or worse not in quoted:
+                return None
+            behind = runs_behind(runs, size.get("runs"), [str(v) for v in quoted.values()], self.spec["metric"],
+                                 self.spec.get("scale", 1.0))
+            return Effect(float(quoted[better]), float(quoted[worse]), behind, size.get("kind", "difference"))
         if not size or self.published is None:
             return None
         table = next(t for t in self.experiment["report"]["tables"] if t["name"] == size["table"])
@@ -294,7 +300,10 @@ class Order(ClaimTest):
         values = [match(theirs, str(methods.get(m, m)), condition, table)["number"] for m in (better, worse)]
         if any(len(v) != 1 or not np.isfinite(v.iloc[0]) for v in values):
             return None
-        return Effect(float(values[0].iloc[0]), float(values[1].iloc[0]), size.get("kind", "difference"))
+        stated = table.get("paper_runs") if table.get("paper_runs_stated", True) else None
+        printed = list(theirs.loc[theirs["number"].notna(), "value"])  # as printed: their precision
+        behind = runs_behind(runs, stated, printed, table["metric"], table.get("scale", 1.0))
+        return Effect(float(values[0].iloc[0]), float(values[1].iloc[0]), behind, size.get("kind", "difference"))
 
 
 class EqualCost(ClaimTest):
@@ -369,14 +378,23 @@ def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allo
     binary = kind.proportion
     unit = kind.high * scale if binary else scale  # yes/no outcomes are tested as 0 or 1
     # the paper's numbers are in the claim's units (a share printed in %, scale 100): tested in the runs' own
-    as_tested = Effect(paper.better / unit, paper.worse / unit, paper.kind) if paper else None
+    as_tested = replace(paper, better=paper.better / unit, worse=paper.worse / unit) if paper else None
     tested = order_test(better * scale / unit, worse * scale / unit, kind.lower_is_better, binary,
                         allowed * scale / unit, as_tested)
-    difference = _shown(tested.gain, unit * (-1 if kind.lower_is_better else 1), runs, allowed * scale / unit)
+    difference = _shown(tested, unit * (-1 if kind.lower_is_better else 1), runs, allowed * scale / unit)
     few = too_few(runs)
     if few:
         return few, difference
+    if tested.tied:
+        return Verdict(Outcome.NOT_TESTABLE, _tied(float(better[0]), runs, kind, scale)), difference
     return _order_verdict(tested, paper, unit, binary), difference
+
+
+def _tied(value: float, runs: int, kind, scale: float) -> str:
+    """Why a pair whose every run of both methods gives one ``value`` (a floor, a ceiling) decides nothing."""
+    where = "at the floor" if value == kind.low else "at the ceiling" if value == kind.high else "at one value"
+    said = f"{value * runs:.0f} of {runs}" if kind.proportion else f"{value * scale:.4g}"
+    return f"every run of both methods {where} ({said}): the scene decides nothing about the paper here"
 
 
 def _shown_gap(paper: Effect | None) -> float | None:
@@ -384,13 +402,18 @@ def _shown_gap(paper: Effect | None) -> float | None:
     return None if paper is None or paper.kind != "difference" else paper.better - paper.worse
 
 
-def _shown(test: Test, factor: float, runs: int, allowed: float = 0.0) -> Estimate:
-    """A gain's test as the difference better - worse in the claim's units (``factor`` flips the sign where
-    lower is better), with the test's 90 % interval; ``allowed``, the margin the test added to the gain in
-    the claim's favour, taken back out: the raw difference."""
-    ends = sorted([(float(test.low) - allowed) * factor, (float(test.high) - allowed) * factor])
-    return Estimate((float(test.value) - allowed) * factor, *ends, runs, f"paired {test.method}",
-                    1 - 2 * INFERENCE.alpha)
+def _shown(tested: OrderTest, factor: float, runs: int, allowed: float = 0.0) -> Estimate:
+    """A pair's gain as the difference better - worse in the claim's units (``factor`` flips the sign where
+    lower is better); ``allowed``, the margin the test added to the gain in the claim's favour, taken back out:
+    the raw difference.  Each end of its interval is the one-sided bound of the test it decides: the
+    direction's (95 %), and on the paper's side the size test's where it is tested in these units (ours with
+    the paper's noise, one-sided at the size test's level)."""
+    test, bound = tested.gain, tested.bound
+    ends = sorted([(float(test.low) - allowed) * factor, (float(bound.high) - allowed) * factor])
+    sized = bound is not test
+    return Estimate((float(test.value) - allowed) * factor, *ends, runs,
+                    f"paired {test.method}" + (f"; its end on the paper's side {bound.method}" if sized else ""),
+                    1 - INFERENCE.alpha - (INFERENCE.size_alpha if sized else INFERENCE.alpha))
 
 
 def _allowing(verdict: Verdict, difference: Estimate, line: float, baseline: float, unit: str) -> Verdict:
@@ -422,7 +445,8 @@ def _order_verdict(tested: OrderTest, paper: Effect | None, unit: float, binary:
     detect = f"; {tested.gain.runs} runs detect {smallest:.3g} with 80% power" \
         if math.isfinite(smallest) and smallest > 0 and not binary else ""
     said = said_p(p_for) if p_for is not None else "every run ties"
-    return Verdict(Outcome.INCONCLUSIVE, f"{said}{detect}", p_for, p_against)
+    size = f"; the paper's {paper} not excluded" if sized else ""
+    return Verdict(Outcome.INCONCLUSIVE, f"{said}{detect}{size}", p_for, p_against)
 
 
 class Cells(ClaimTest):

@@ -56,15 +56,24 @@ def mean_test(values, reference=0.0) -> Test:
     n = x.shape[-1]
     mean = x.mean(axis=-1)
     se = x.std(axis=-1, ddof=1) / np.sqrt(n) if n > 1 else np.full(mean.shape, np.nan)
-    spread = se > 1e-12 * np.maximum(1.0, np.abs(mean))
+    return t_test(mean, se, n - 1, n, reference)
+
+
+def t_test(estimate, se, df, runs: int, reference=0.0, method: str = "t", alpha: float | None = None) -> Test:
+    """An estimate with standard error ``se`` against ``reference``, its studentised difference referred to
+    Student's t with ``df`` degrees of freedom, with the interval of that t whose each bound is one-sided at
+    ``alpha`` (None: INFERENCE.alpha); undefined (NaN) where the standard error vanishes or ``df`` < 1."""
+    estimate, se = np.asarray(estimate, dtype=float), np.asarray(se, dtype=float)
+    spread = se > 1e-12 * np.maximum(1.0, np.abs(estimate))
+    if df < 1:
+        spread = np.zeros(np.shape(spread), dtype=bool)
     with np.errstate(all="ignore"):
-        t = np.where(spread, (mean - reference) / se, np.nan)
-        half = stats.t.ppf(1 - INFERENCE.alpha, n - 1) * se if n > 1 else np.nan
+        t = np.where(spread, (estimate - reference) / se, np.nan)
+        half = stats.t.ppf(1 - (INFERENCE.alpha if alpha is None else alpha), max(df, 1)) * se
     # each tail directly, never one as 1 minus the other (which rounds a tail under 1e-16 to 0)
-    p_above = stats.t.sf(t, n - 1) if n > 1 else np.full(np.shape(t), np.nan)
-    p_below = stats.t.cdf(t, n - 1) if n > 1 else np.full(np.shape(t), np.nan)
-    low, high = np.where(spread, mean - half, np.nan), np.where(spread, mean + half, np.nan)
-    return Test(mean, low, high, p_above, p_below, n, "t")
+    p_above, p_below = stats.t.sf(t, max(df, 1)), stats.t.cdf(t, max(df, 1))
+    low, high = np.where(spread, estimate - half, np.nan), np.where(spread, estimate + half, np.nan)
+    return Test(estimate, low, high, p_above, p_below, runs, method)
 
 
 def sign_test(values, reference=0.0) -> Test:

@@ -19,6 +19,7 @@ class Inference:
     level: float  # the coverage of every interval shown beside a number
     power: float  # the power at which the smallest detectable effect is quoted
     equivalence_alpha: float  # each side of the t-based equivalence test of a published mean
+    size_alpha: float  # the test of ours against the paper's size, the paper's own noise estimated from ours
     tolerance: float  # a published number is reproduced within +-tolerance of it where its table states none
     min_runs: int  # no verdict from fewer runs
     min_sequences: int  # no ranking verdict over fewer sequences
@@ -44,8 +45,9 @@ def configure(values) -> Inference:
     if unknown:
         raise ConfigError(f"inference: unknown setting(s) {sorted(unknown)}; known: {sorted(known)}")
     chosen = {**INFERENCE.as_dict(), **{k: (int if known[k] is int else float)(v) for k, v in values.items()}}
-    if not all(0 < chosen[k] < 1 for k in ("alpha", "level", "power", "equivalence_alpha", "tolerance")):
-        raise ConfigError("inference: alpha, level, power, equivalence_alpha and tolerance lie strictly in (0, 1)")
+    if not all(0 < chosen[k] < 1 for k in ("alpha", "level", "power", "equivalence_alpha", "size_alpha", "tolerance")):
+        raise ConfigError("inference: alpha, level, power, equivalence_alpha, size_alpha and tolerance lie strictly "
+                          "in (0, 1)")
     if chosen["min_runs"] < 2 or chosen["min_sequences"] < 2 or chosen["bootstrap_resamples"] < 1:
         raise ConfigError("inference: min_runs and min_sequences are at least 2, bootstrap_resamples at least 1")
     for name, value in chosen.items():
@@ -69,7 +71,11 @@ def rules() -> tuple[str, ...]:
         "Two methods (a claim's check): Student's paired t-test on common random numbers, McNemar's exact (sign) "
         "test for yes/no outcomes. Where the claim or its published cells quote a size, the paper's own gap (a "
         "difference, or a ratio in Fieller's linear form) is tested against ours, so that 'the effect the paper "
-        "reports is absent here' and 'the sign agrees, the size does not' are verdicts.",
+        "reports is absent here' and 'the sign agrees, the size does not' are verdicts. The paper's gap is itself "
+        "a mean over its runs (stated, else the fewest that give its rates, else as many as ours; said beside "
+        "each check), its noise taken from our runs' spread; that test runs at "
+        f"{_percent(s.size_alpha)} so that heavy-tailed runs still hold {_percent(s.alpha)}, and runs all at one "
+        "value for both methods decide nothing.",
         "A claim: reproduced when every check shows the claimed direction (an intersection-union test, no "
         "correction needed); not reproduced when some check's evidence against it (the other direction, or the "
         "paper's size absent) survives Holm's correction across the reading's checks; else inconclusive, with the "
