@@ -17,6 +17,11 @@ functions the claims and tables call (:func:`~replication.evidence.comparisons.o
   claim's favour (``guards = "reproduced"``: ``rate`` is the power) or against
   it (``guards = "not reproduced"``).
 
+A paper's size is itself an estimate: its rows (``paper_runs``) draw the
+paper's two numbers as means of ``paper_runs`` runs each, from the same noise as
+ours but unpaired, its true effect ours in the null and twice ours in the effect
+rows (ours at half the paper's size), at the papers' counts and at ours.
+
 Noise, standardised to mean 0 and standard deviation 1: ``normal``, ``t3``
 (heavy tails) and ``lognormal`` (skewed, sigma = 0.5: skewness 1.75).  Two
 methods compared on common random numbers share a run's draw and add their
@@ -30,7 +35,8 @@ and they are simulated at both edges of the band.
 Control rows (``control``) run the rules this project used before (a BCa
 bootstrap interval at 5 runs; any check against the claim failing it, with no
 correction; a method best when it ranked first in 95 % of bootstrap resamples,
-not best at 5 %), so the simulation is seen to catch a bad rule.
+not best at 5 %; the paper's size taken as exact, at the size test's level), so
+the simulation is seen to catch a bad rule.
 """
 
 import math
@@ -43,6 +49,7 @@ import pandas as pd
 from scipy import stats
 
 from replication.evidence.comparisons import Effect, best_test, order_test
+from replication.evidence.original import PaperRuns
 from replication.evidence.inference import holm, mean_test, sign_test
 from replication.evidence.ranking import rank, rank_set
 from replication.evidence.robustness import depends
@@ -63,8 +70,9 @@ LOGNORMAL_SIGMA = 0.5
 RUNS = (5, 6, 10, 20, 30, 50, 100)
 CHAINS = (6, 9)  # checks in a reading: ism_pf.accuracy (2 pairs x 3 scenes), gps_qmcpf.rmse (3 x 3)
 EFFECTS = (0.5, 1.0)
-COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "rate", "mc_se", "wrong_rate",
-           "power", "holds", "control", "replications"]
+PAPER_RUNS = (10, 20, 100)  # the papers' counts behind a size: bis_pf; fusion_pf's fewest, the helicopter; ism_pf
+COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "paper_runs", "rate", "mc_se",
+           "wrong_rate", "power", "holds", "control", "replications"]
 REPRODUCED, NOT_REPRODUCED = OUTCOMES.index(Outcome.REPRODUCED), OUTCOMES.index(Outcome.NOT_REPRODUCED)
 
 
@@ -93,6 +101,7 @@ class Case:
     effect: float
     draw: Callable[[np.random.Generator, int], np.ndarray]
     control: bool = False
+    paper_runs: float = math.nan  # the runs behind each of the paper's simulated numbers (a size's rows)
 
 
 def _pairs(rng, reps: int, runs: int, distribution: str, gains) -> tuple[np.ndarray, np.ndarray]:
@@ -110,46 +119,79 @@ def _reading(p_for, p_against) -> np.ndarray:
     return decide(p_for, p_against)[1]
 
 
-def order_case(runs, distribution, truth, guards, effect, checks=1, paper_gain=None, others=0.0) -> Case:
+def _paper_means(rng, shape, paper_runs: int, distribution: str) -> np.ndarray:
+    """Means over ``paper_runs`` runs of a method of the paper's, each run a shared and an own draw as ours
+    (the paper's methods unpaired: each mean its own runs), summed a run at a time to stay small."""
+    total = np.zeros(shape)
+    for _ in range(paper_runs):
+        total += noise(distribution, rng, shape) + noise(distribution, rng, shape)
+    return total / paper_runs
+
+
+def _told(paper_runs: int, exact: bool) -> PaperRuns:
+    """The runs the test is told stand behind the paper's numbers (``exact``: none, the rule before)."""
+    return PaperRuns(math.inf, False, "taken as exact") if exact else PaperRuns(paper_runs, True, "simulated")
+
+
+def order_case(runs, distribution, truth, guards, effect, checks=1, paper_gain=None, others=0.0, paper_runs=None,
+               exact=False) -> Case:
     """A reading of ``checks`` paired checks: the first at ``effect``, the rest at ``others`` (an
-    intersection-union rule is at its worst with one check null and the rest strong)."""
+    intersection-union rule is at its worst with one check null and the rest strong).  ``paper_gain``: the
+    paper's true gain at every check, its two numbers means of ``paper_runs`` runs each (``exact``: tested as
+    if exact, the rule before)."""
     def draw(rng, reps):
         gains = [effect] + [others] * (checks - 1)
         better, worse = _pairs(rng, reps, runs, distribution, gains)
-        paper = None if paper_gain is None else Effect(paper_gain * math.sqrt(2.0), 0.0)
+        paper = None
+        if paper_gain is not None:
+            theirs = _paper_means(rng, (2, reps, checks), paper_runs, distribution)
+            paper = Effect(theirs[0] + paper_gain * math.sqrt(2.0), theirs[1], _told(paper_runs, exact))
         tested = order_test(better, worse, lower_is_better=False, paper=paper)
         return _reading(tested.p_for, tested.p_against)
 
-    name = "order" if paper_gain is None else "order, paper's size"
-    return Case(name if checks == 1 else f"{name}: reading", runs, checks, distribution, truth, guards, effect, draw)
+    name = "order" if paper_gain is None else "order, paper's size" + (" taken as exact (old rule)" if exact else "")
+    return Case(name if checks == 1 else f"{name}: reading", runs, checks, distribution, truth, guards, effect, draw,
+                exact, math.nan if paper_gain is None else paper_runs)
 
 
-def ratio_case(runs, distribution, truth, guards, ratio) -> Case:
-    """A claimed ratio of means (lower is better: the paper's 0.5, ours ``ratio``): the size tested as
-    Fieller's linear form."""
+def ratio_case(runs, distribution, truth, guards, ratio, paper_runs, exact=False) -> Case:
+    """A claimed ratio of means (lower is better: the paper's true 0.5, ours ``ratio``; a run's coefficient of
+    variation 0.1 sqrt 2): the size tested as Fieller's linear form, the paper's two numbers means of
+    ``paper_runs`` runs each (``exact``: tested as if exact)."""
     def draw(rng, reps):
         shared = noise(distribution, rng, (reps, runs))
         worse = 10.0 * (1 + 0.1 * (shared + noise(distribution, rng, (reps, runs))))
         better = ratio * 10.0 * (1 + 0.1 * (shared + noise(distribution, rng, (reps, runs))))
-        tested = order_test(better, worse, lower_is_better=True, paper=Effect(0.5, 1.0, "ratio"))
+        theirs = 10.0 * (1 + 0.1 * _paper_means(rng, (2, reps), paper_runs, distribution))
+        paper = Effect(0.5 * theirs[0], theirs[1], _told(paper_runs, exact), "ratio")
+        tested = order_test(better, worse, lower_is_better=True, paper=paper)
         return _reading(tested.p_for[..., None], tested.p_against[..., None])
 
-    return Case("order, paper's ratio", runs, 1, distribution, truth, guards, ratio, draw)
+    name = "order, paper's ratio" + (" taken as exact (old rule)" if exact else "")
+    return Case(name, runs, 1, distribution, truth, guards, ratio, draw, exact, paper_runs)
 
 
-def mcnemar_case(runs, truth, guards, wins, losses, paper_gain=None) -> Case:
+def mcnemar_case(runs, truth, guards, wins, losses, paper=None, paper_runs=None, both=0.0, exact=False) -> Case:
     """Paired yes/no outcomes: a run is won by the claimed-better method alone with probability ``wins``,
-    lost with ``losses``, tied otherwise (``effect``: wins - losses)."""
+    lost with ``losses``, won by both with ``both``, lost by both otherwise (``effect``: wins - losses).
+    ``paper``: the paper's two true rates, its numbers each the share of ``paper_runs`` runs of its own
+    (``exact``: tested as if exact)."""
     def draw(rng, reps):
         u = rng.random((reps, runs))
-        better = (u < wins).astype(float)
-        worse = ((u >= wins) & (u < wins + losses)).astype(float)
-        paper = None if paper_gain is None else Effect(paper_gain, 0.0)
-        tested = order_test(better, worse, lower_is_better=False, binary=True, paper=paper)
+        both_won = (u >= wins + losses) & (u < wins + losses + both)
+        better = ((u < wins) | both_won).astype(float)
+        worse = (((u >= wins) & (u < wins + losses)) | both_won).astype(float)
+        effect = None
+        if paper is not None:
+            rates = rng.binomial(paper_runs, paper, (reps, 2)) / paper_runs
+            effect = Effect(rates[:, 0], rates[:, 1], _told(paper_runs, exact))
+        tested = order_test(better, worse, lower_is_better=False, binary=True, paper=effect)
         return _reading(tested.p_for[..., None], tested.p_against[..., None])
 
-    name = "order, yes/no" + ("" if paper_gain is None else ", paper's size")
-    return Case(name, runs, 1, "yes/no", truth, guards, round(wins - losses, 3), draw)
+    name = "order, yes/no" + ("" if paper is None else ", paper's size") + (" taken as exact (old rule)" if exact
+                                                                           else "")
+    return Case(name, runs, 1, "yes/no", truth, guards, round(wins - losses, 3), draw, exact,
+                math.nan if paper is None else paper_runs)
 
 
 def threshold_case(runs, distribution, truth, guards, effect) -> Case:
@@ -348,10 +390,6 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
         for d in distributions:
             found += [order_case(n, d, "null", "reproduced", 0.0), order_case(n, d, "null", "not reproduced", 0.0)]
             found += [order_case(n, d, "effect", "reproduced", e) for e in EFFECTS]
-            found += [order_case(n, d, "null", "not reproduced", 1.0, paper_gain=1.0),
-                      order_case(n, d, "effect", "not reproduced", 0.0, paper_gain=1.0)]
-            found += [ratio_case(n, d, "null", "not reproduced", 0.5), ratio_case(n, d, "effect", "not reproduced",
-                                                                                   1.0)]
             found += [threshold_case(n, d, "null", "reproduced", 0.0), threshold_case(n, d, "null", "not reproduced",
                                                                                       0.0)]
             found += [threshold_case(n, d, "effect", "reproduced", e) for e in EFFECTS]
@@ -362,14 +400,14 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
             for k in CHAINS:
                 found += [order_case(n, d, "null", "reproduced", 0.0, checks=k, others=3.0),
                           order_case(n, d, "null", "not reproduced", 0.0, checks=k),
-                          order_case(n, d, "null", "not reproduced", 1.0, checks=k, paper_gain=1.0, others=1.0),
+                          order_case(n, d, "null", "not reproduced", 1.0, checks=k, paper_gain=1.0, others=1.0,
+                                     paper_runs=n),
                           order_case(n, d, "effect", "reproduced", 1.0, checks=k, others=1.0)]
         found += [robustness_case(n, d, "null", "depends on the reading", 0.0) for d in distributions]
         found += [robustness_case(n, d, "effect", "depends on the reading", -1.0) for d in distributions]
         found += [mcnemar_case(n, "null", "reproduced", 0.2, 0.2), mcnemar_case(n, "null", "not reproduced", 0.2, 0.2),
-                  mcnemar_case(n, "effect", "reproduced", 0.5, 0.0),
-                  mcnemar_case(n, "null", "not reproduced", 0.45, 0.05, paper_gain=0.4),
-                  mcnemar_case(n, "effect", "not reproduced", 0.1, 0.1, paper_gain=0.4)]
+                  mcnemar_case(n, "effect", "reproduced", 0.5, 0.0)]
+        found += size_cases(n, distributions)
         found += [rate_case(n, "null", "reproduced", 0.72), rate_case(n, "null", "reproduced", 0.88),
                   rate_case(n, "null", "not reproduced", 0.8), rate_case(n, "effect", "reproduced", 0.8)]
     for n in (5, 10):
@@ -390,9 +428,32 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
     return found
 
 
+def size_cases(runs: int, distributions=DISTRIBUTIONS) -> list[Case]:
+    """The rows of a paper's size at our ``runs``: the paper's numbers means of each count of
+    :data:`PAPER_RUNS` and of as many runs as ours; the null (ours the paper's true effect) and ours at half
+    its size, for a difference, a ratio and yes/no outcomes (40 pp apart as 45 % and 5 %, and as fusion_pf's
+    95 % and 55 %); and the rule before (the paper's numbers, means of as many runs as ours, taken as exact)."""
+    found = []
+    for m in sorted({*PAPER_RUNS, runs}):
+        for d in distributions:
+            found += [order_case(runs, d, "null", "not reproduced", 1.0, paper_gain=1.0, paper_runs=m),
+                      order_case(runs, d, "effect", "not reproduced", 0.5, paper_gain=1.0, paper_runs=m),
+                      ratio_case(runs, d, "null", "not reproduced", 0.5, m),
+                      ratio_case(runs, d, "effect", "not reproduced", 0.75, m)]
+        found += [mcnemar_case(runs, "null", "not reproduced", 0.45, 0.05, (0.45, 0.05), m),
+                  mcnemar_case(runs, "effect", "not reproduced", 0.25, 0.05, (0.45, 0.05), m),
+                  mcnemar_case(runs, "null", "not reproduced", 0.4, 0.0, (0.95, 0.55), m, both=0.55),
+                  mcnemar_case(runs, "effect", "not reproduced", 0.2, 0.0, (0.95, 0.55), m, both=0.55)]
+    return found + [order_case(runs, "normal", "null", "not reproduced", 1.0, paper_gain=1.0, paper_runs=runs,
+                               exact=True),
+                    ratio_case(runs, "normal", "null", "not reproduced", 0.5, runs, exact=True),
+                    mcnemar_case(runs, "null", "not reproduced", 0.45, 0.05, (0.45, 0.05), runs, exact=True)]
+
+
 def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
     """One row: the share of replications giving the verdict the case guards, with its Monte Carlo error."""
-    name = repr((case.test, case.runs, case.checks, case.distribution, case.truth, case.guards, case.effect))
+    name = repr((case.test, case.runs, case.checks, case.distribution, case.truth, case.guards, case.effect)
+                + ((case.paper_runs,) if math.isfinite(case.paper_runs) else ()))
     rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
     codes = case.draw(rng, replications)
     guarded = REPRODUCED if case.guards in ("reproduced", "robust") else NOT_REPRODUCED  # or "depends", "misses"
@@ -400,7 +461,8 @@ def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
     mc_se = math.sqrt(max(rate * (1 - rate), 1e-12) / replications)
     null = case.truth == "null"
     return {"test": case.test, "runs": case.runs, "checks": case.checks, "distribution": case.distribution,
-            "truth": case.truth, "guards": case.guards, "effect": case.effect, "rate": rate, "mc_se": mc_se,
+            "truth": case.truth, "guards": case.guards, "effect": case.effect, "paper_runs": case.paper_runs,
+            "rate": rate, "mc_se": mc_se,
             "wrong_rate": rate if null else float(np.mean(codes == (NOT_REPRODUCED if guarded == REPRODUCED
                                                                      else REPRODUCED))),
             "power": math.nan if null else rate, "holds": (rate <= INFERENCE.alpha + 2 * mc_se) if null else None,
