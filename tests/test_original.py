@@ -158,6 +158,18 @@ def test_a_users_quoted_numbers_carry_the_runs_it_gives():
         assert said in check.verdict.why and check.verdict.outcome is Outcome.REPRODUCED  # ours 2.5, theirs 2.6
 
 
+def test_a_shown_difference_of_rates_stays_within_100_points():
+    # every run won by A alone: ours +100 pp, whose bound with the paper's noise would pass 100
+    metric = "tracked_to_end[cle<=20]"
+    records = typed(pd.DataFrame([{"method": m, "condition": "N=1", "data_condition": "", "repetition": r,
+                                   metric: float(m == "A")} for m in ("A", "B") for r in range(100)]))
+    spec = {"test": "order", "metric": metric, "order": ["A", "B"], "scale": 100,
+            "size": {"quoted": {"A": 86.4, "B": 14.7}, "runs": 100}}
+    check = ClaimTest.of(spec, {"methods": {}}).checks(records, {})[0]
+    assert check.estimate.value == 100.0 and check.estimate.high == 100.0 and check.estimate.low > 90.0
+    assert check.verdict.outcome is Outcome.REPRODUCED
+
+
 def test_the_interval_shown_is_the_one_each_test_decides_by():
     check, better, worse = _check({}, gap=1.0)  # lower is better: A - B's lower end is the size test's bound
     tested = order_test(better, worse, True, paper=Effect(1.6, 4.2, PaperRuns(20, False, "")))

@@ -381,7 +381,8 @@ def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allo
     as_tested = replace(paper, better=paper.better / unit, worse=paper.worse / unit) if paper else None
     tested = order_test(better * scale / unit, worse * scale / unit, kind.lower_is_better, binary,
                         allowed * scale / unit, as_tested)
-    difference = _shown(tested, unit * (-1 if kind.lower_is_better else 1), runs, allowed * scale / unit)
+    difference = _shown(tested, unit * (-1 if kind.lower_is_better else 1), runs, allowed * scale / unit,
+                        (kind.high - kind.low) * scale)
     few = too_few(runs)
     if few:
         return few, difference
@@ -402,16 +403,18 @@ def _shown_gap(paper: Effect | None) -> float | None:
     return None if paper is None or paper.kind != "difference" else paper.better - paper.worse
 
 
-def _shown(tested: OrderTest, factor: float, runs: int, allowed: float = 0.0) -> Estimate:
+def _shown(tested: OrderTest, factor: float, runs: int, allowed: float, span: float) -> Estimate:
     """A pair's gain as the difference better - worse in the claim's units (``factor`` flips the sign where
     lower is better); ``allowed``, the margin the test added to the gain in the claim's favour, taken back out:
     the raw difference.  Each end of its interval is the one-sided bound of the test it decides: the
     direction's (95 %), and on the paper's side the size test's where it is tested in these units (ours with
-    the paper's noise, one-sided at the size test's level)."""
+    the paper's noise, one-sided at the size test's level); within the differences the metric's range
+    allows (+-``span``)."""
     test, bound = tested.gain, tested.bound
-    ends = sorted([(float(test.low) - allowed) * factor, (float(bound.high) - allowed) * factor])
+    ends = np.clip(sorted([(float(test.low) - allowed) * factor, (float(bound.high) - allowed) * factor]), -span,
+                   span)
     sized = bound is not test
-    return Estimate((float(test.value) - allowed) * factor, *ends, runs,
+    return Estimate((float(test.value) - allowed) * factor, *map(float, ends), runs,
                     f"paired {test.method}" + (f"; its end on the paper's side {bound.method}" if sized else ""),
                     1 - INFERENCE.alpha - (INFERENCE.size_alpha if sized else INFERENCE.alpha))
 
