@@ -241,7 +241,7 @@ def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_lin
 
 def test_threshold():
     records = _records({"A": 0.0, "B": 1.0}, metric="fps")
-    here = {"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "machine": "this"}
+    here = {"test": "threshold", "metric": "fps", "method": "A", "condition": {"N": 1}, "machine": "this"}
     assert _verdict({**here, "at_least": 2.0, "statistic": "median"}, records).outcome is Outcome.REPRODUCED
     assert _verdict({**here, "at_least": 50.0}, records).outcome is Outcome.NOT_REPRODUCED
     # 5 runs all above the bound: the exact sign test's floor, 1/32, decides (no order-statistic 95% interval)
@@ -252,7 +252,7 @@ def test_threshold():
 
 def test_a_time_measured_on_another_machine_is_not_testable_and_the_ratio_is_shown():
     five = _records({"A": 20.0}, runs=5, metric="fps")
-    spec = {"test": "threshold", "metric": "fps", "method": "A", "condition": "N=1", "at_least": 5.52}
+    spec = {"test": "threshold", "metric": "fps", "method": "A", "condition": {"N": 1}, "at_least": 5.52}
     verdict = _verdict(spec, five)
     median = float(np.median(five.loc[five["method"] == "A", "fps"]))
     assert verdict.outcome is Outcome.NOT_TESTABLE
@@ -281,7 +281,7 @@ def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
                               "note": [""], "number": [np.nan]})
     records = typed(pd.DataFrame({"method": "A", "condition": "scene=s", "failed": [0.0] * 28 + [1.0] * 12}))
     spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability",
-            "match": {"scene=s": {"experiment": "s"}}}
+            "match": [{"ours": {"scene": "s"}, "paper": {"experiment": "s"}}]}
     table = Rating(spec, {"paper": "p", "methods": {"A": {}}}, published).build(records)
     result = Result.of(ClaimTest.of({"test": "cells", "tables": ["t3"]}, EXPERIMENT).checks(records, {"t3": table}))
     assert result.verdict.outcome is Outcome.NOT_REPRODUCED  # 12 of 40 failed: [0.18, 0.45], medium, not good
@@ -355,7 +355,7 @@ def test_each_check_shows_the_interval_of_the_level_it_names():
     ninety = stats.ttest_1samp(runs["A"] - runs["B"], 0.0).confidence_interval(0.90)
     assert (order.estimate.low, order.estimate.high) == pytest.approx((ninety.low, ninety.high))
     assert order.estimate.level == pytest.approx(0.90) and order.number.endswith(" (90% CI)")
-    (bound,) = ClaimTest.of({"test": "threshold", "metric": "rmse", "method": "A", "condition": "N=1",
+    (bound,) = ClaimTest.of({"test": "threshold", "metric": "rmse", "method": "A", "condition": {"N": 1},
                              "at_most": 6.0}, EXPERIMENT).checks(records, {})
     ninety = stats.ttest_1samp(runs["A"], 6.0).confidence_interval(0.90)
     assert (bound.estimate.low, bound.estimate.high) == pytest.approx((ninety.low, ninety.high))

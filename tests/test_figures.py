@@ -192,7 +192,8 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
     records = typed(pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]}))
     with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
-        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": ["scene=c"]}, {}, tmp_path / "f.png")
+        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": [{"scene": "c"}]}, {},
+                     tmp_path / "f.png")
     no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0], "strip": [None]}))
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):  # no run on the 3123 scene
         tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
@@ -200,7 +201,7 @@ def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypa
         figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png")
     seen = []
     monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
-    figures.draw(records, {"kind": "probe", "conditions": ["scene=b"]}, {}, tmp_path / "g.png")
+    figures.draw(records, {"kind": "probe", "conditions": [{"scene": "b"}]}, {}, tmp_path / "g.png")
     assert seen == [["scene=b"]]
 
 

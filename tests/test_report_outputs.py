@@ -38,14 +38,15 @@ CSV = (
 )
 CONFIGS = {
     "qmc_ungm": {"paper": "qmc", "methods": {"PF": {}}, "report": {"tables": [
-        {"name": "t1", "paper_table": "1", "metric": "rmse", "match": {"N=100": "N=100"}}]}},
+        {"name": "t1", "paper_table": "1", "metric": "rmse",
+         "match": [{"ours": {"N": 100}, "paper": {"condition": "N=100"}}]}]}},
     "qmc_heli": {"paper": "qmc", "methods": {"PF": {}}, "report": {"tables": [
         {"name": "t2", "paper_table": ["2"], "metric": "ess"}]}},
     "trk": {"paper": "trk", "methods": {"PF": {}, "MCMC": {}}, "report": {"tables": [
         {"name": "time", "paper_table": "1", "metric": "ms", "paper_metric": "time",
-         "match": {"scene=office": {"experiment": "office"}}},
+         "match": [{"ours": {"scene": "office"}, "paper": {"experiment": "office"}}]},
         {"name": "rate", "paper_table": "1", "metric": "r", "paper_metric": "rate",
-         "match": {"scene=office": {"experiment": "office"}}}]}},
+         "match": [{"ours": {"scene": "office"}, "paper": {"experiment": "office"}}]}]}},
     "ablation": {"methods": {"PF": {}}, "report": {"tables": [{"name": "s", "metrics": ["rmse"]}]}},
 }
 

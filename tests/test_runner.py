@@ -382,7 +382,7 @@ def test_a_table_whose_scene_is_not_run_is_named_before_any_work(make_cfg):
 
     _, skipped, _ = prepare(make_cfg("bis_pf", "scale=quick", "experiment.model.sweep.scene=[exp2_16_targets]"))
     named = [line for line in skipped if "table" in line]
-    assert named == ["bis_pf: table modes_3123 needs scene=exp1_3123, which no run of this request has: its page "
+    assert named == ["bis_pf: table modes_3123 needs {scene: exp1_3123}, which no run of this request has: its page "
                      "will leave it out"]  # table3_stability matches 16 balls too: it stays
     _, everything, _ = prepare(make_cfg("bis_pf", "scale=quick"))
     assert not [line for line in everything if "table" in line]

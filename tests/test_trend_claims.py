@@ -57,7 +57,7 @@ def _sweep(time: dict, error: dict, runs: int = 10) -> pd.DataFrame:
 
 
 def test_a_balance_holds_where_no_setting_is_better_on_both_and_fails_where_one_is():
-    spec = {"test": "pareto", "method": "H", "chosen": "s=a", "metrics": ["rmse", "ms_per_step"]}
+    spec = {"test": "pareto", "method": "H", "chosen": {"s": "a"}, "metrics": ["rmse", "ms_per_step"]}
     balanced = _sweep({"s=a": 0.0, "s=b": 0.5, "s=c": -0.5}, {"s=a": 0.0, "s=b": -0.5, "s=c": 0.5})  # b slower, c worse
     assert _verdict(spec, balanced).outcome is Outcome.REPRODUCED
     dominated = _sweep({"s=a": 0.0, "s=b": -0.5}, {"s=a": 0.0, "s=b": -0.5})  # b faster and more accurate

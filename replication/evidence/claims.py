@@ -30,6 +30,7 @@ import yaml
 
 from replication.evidence.comparisons import Effect, OrderTest, best_test, order_test
 from replication.evidence.inference import mean_test, proportion_test, said_p, sign_test
+from replication.evidence.named_conditions import as_mappings, matching
 from replication.evidence.original import runs_behind
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate, said_level
@@ -46,6 +47,7 @@ from replication.evidence.settings import INFERENCE
 
 CLAIMS_DIR = CONF_DIR / "claims"
 EQUAL_N = "equal N"  # what a reading at the paper's own settings compares at
+NAMING = ("conditions", "condition", "chosen")  # the keys under which a reading names conditions
 WORK = "evaluations_per_step"  # the work counted beside a time (replication.smc.work)
 
 
@@ -103,6 +105,7 @@ class Paper:
     authors: str
     venue: str
     claims: tuple[Claim, ...]
+    path: Path | None = None  # its claims file
 
 
 @dataclass(frozen=True)
@@ -232,7 +235,12 @@ class ClaimTest:
         return []
 
     def conditions(self, records: pd.DataFrame) -> list[str]:
-        return [str(c) for c in _listed(self.spec.get("conditions"))] or list(dict.fromkeys(records["condition"]))
+        """The labels of the conditions of ``records`` that the reading names (:func:`named`), each once, in the
+        order named; every condition of ``records`` where it names none."""
+        wanted = named(self.spec)
+        if not wanted:
+            return list(dict.fromkeys(records["condition"]))
+        return list(dict.fromkeys(label for w in wanted for label in records.loc[matching(records, w), "condition"]))
 
 
 class Order(ClaimTest):
@@ -266,7 +274,7 @@ class Order(ClaimTest):
                         continue
                     allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-                    paper = self.effect(a, b, condition, len(paired))
+                    paper = self.effect(a, b, records[records["condition"] == condition].iloc[0], len(paired))
                     verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
                     # the line the difference better - worse is tested against: worse by at most the allowance
                     line = allowed * scale * (1 if kind.lower_is_better else -1)
@@ -278,11 +286,11 @@ class Order(ClaimTest):
                                        _shown_gap(paper), kind.machine_dependent))
         return found
 
-    def effect(self, better: str, worse: str, condition: str, runs: int) -> Effect | None:
-        """The paper's numbers for the pair at our ``condition``, matched with its cells as our table named by
-        ``size.table`` matches them (None where ``size`` names none, or a number is missing), with the runs
-        behind them by :func:`~replication.evidence.original.paper_runs` (``runs``: ours): the table's
-        ``paper_runs`` where the paper states them (a user's ``size.runs``)."""
+    def effect(self, better: str, worse: str, ours: pd.Series, runs: int) -> Effect | None:
+        """The paper's numbers for the pair at our condition (``ours``: a run's record there), matched with its
+        cells as our table named by ``size.table`` matches them (None where ``size`` names none, or a number is
+        missing), with the runs behind them by :func:`~replication.evidence.original.paper_runs` (``runs``:
+        ours): the table's ``paper_runs`` where the paper states them (a user's ``size.runs``)."""
         size = self.spec.get("size")
         if size and "quoted" in size:  # a user's claim quoting its own numbers ({method: number}), no table
             quoted = size["quoted"]
@@ -297,7 +305,7 @@ class Order(ClaimTest):
         theirs = published_cells(self.published, self.experiment["paper"], table["paper_table"],
                                  table.get("paper_metric", table.get("metric")))
         methods = size.get("methods", {})
-        values = [match(theirs, str(methods.get(m, m)), condition, table)["number"] for m in (better, worse)]
+        values = [match(theirs, str(methods.get(m, m)), ours, table)["number"] for m in (better, worse)]
         if any(len(v) != 1 or not np.isfinite(v.iloc[0]) for v in values):
             return None
         stated = table.get("paper_runs") if table.get("paper_runs_stated", True) else None
@@ -477,13 +485,20 @@ class Cells(ClaimTest):
 class Threshold(ClaimTest):
     """``method`` at ``condition`` reaches a bound, ``at_least`` or ``at_most``: the exact sign test of its
     median (``statistic: median``), the exact binomial test of a yes/no rate, else the t-test of its mean,
-    one-sided each way."""
+    one-sided each way.  A check at each of the method's conditions that ``condition`` picks (:func:`named`;
+    none: each of them), named in the check where it picks several."""
 
     name = "threshold"
 
     def checks(self, records, tables):
+        ours = records[records["method"] == self.spec["method"]]
+        labels = self.conditions(ours)
+        return [check for label in labels
+                for check in self.at(ours[ours["condition"] == label], f" at {label}" if len(labels) > 1 else "")]
+
+    def at(self, chosen: pd.DataFrame, where: str) -> list[Check]:
+        """The check on the runs of one condition, ``chosen`` (``where``: the condition, said after the method)."""
         spec = self.spec
-        chosen = records[(records["method"] == spec["method"]) & (records["condition"] == spec.get("condition", ""))]
         metric = spec["metric"]
         chosen = chosen[np.isfinite(chosen[metric].astype(float))]
         if chosen.empty:
@@ -492,7 +507,7 @@ class Threshold(ClaimTest):
         values = chosen[metric].to_numpy(float)
         bound, above = (spec["at_least"], True) if "at_least" in spec else (spec["at_most"], False)
         if kind.machine_dependent and spec.get("machine") != "this":  # a time measured on another machine
-            return [_elsewhere(spec, values, bound, chosen)]
+            return [_elsewhere(spec, values, bound, chosen, where)]
         if kind.proportion:
             test = proportion_test(int(round(values.sum() / kind.high)), len(values), bound / kind.high)
             factor = kind.high
@@ -501,7 +516,7 @@ class Threshold(ClaimTest):
             factor = 1.0
         shown = Estimate(float(test.value) * factor, float(test.low) * factor, float(test.high) * factor,
                          len(values), test.method, 1 - 2 * INFERENCE.alpha)
-        what = f"{spec['method']} {spec.get('statistic', 'mean')} {metric} {'>=' if above else '<='} {bound:g}"
+        what = f"{spec['method']}{where} {spec.get('statistic', 'mean')} {metric} {'>=' if above else '<='} {bound:g}"
         p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
         verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
         return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
@@ -509,11 +524,12 @@ class Threshold(ClaimTest):
                       timed=kind.machine_dependent)]
 
 
-def _elsewhere(spec: dict, values: np.ndarray, bound: float, chosen: pd.DataFrame) -> Check:
+def _elsewhere(spec: dict, values: np.ndarray, bound: float, chosen: pd.DataFrame, where: str = "") -> Check:
     """A bound on a time or frame rate that the paper measured on its own machine: not testable here
-    (docs/statistics.md, "Times"), with our median over theirs shown."""
+    (docs/statistics.md, "Times"), with our median over theirs shown (``where``: the condition, as a
+    threshold's check says it)."""
     ours = float(np.median(values))
-    what = f"{spec['method']} median {spec['metric']} against the paper's {bound:g} (its machine)"
+    what = f"{spec['method']}{where} median {spec['metric']} against the paper's {bound:g} (its machine)"
     why = f"a time measured on another machine is not testable; ours / theirs = {ours / bound:.3g}"
     return Check(what, Verdict(Outcome.NOT_TESTABLE, why), None, spec.get("unit", ""), float(bound),
                  dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound), timed=True)
@@ -633,10 +649,10 @@ class Growth(ClaimTest):
 
 
 class Pareto(ClaimTest):
-    """``method`` at the ``chosen`` condition keeps both ``metrics`` (lower is better) small: against every other
-    condition of the method, one check (:func:`~replication.evidence.trends.dominance`, paired by run): reproduced
-    where, against each, the chosen setting is better on at least one metric; not reproduced where some other
-    setting is better on both, after Holm."""
+    """``method`` at the ``chosen`` condition (a mapping, :func:`named`) keeps both ``metrics`` (lower is better)
+    small: against every other condition of the method, one check (:func:`~replication.evidence.trends.dominance`,
+    paired by run): reproduced where, against each, the chosen setting is better on at least one metric; not
+    reproduced where some other setting is better on both, after Holm."""
 
     name = "pareto"
 
@@ -644,18 +660,20 @@ class Pareto(ClaimTest):
         spec, metrics = self.spec, list(self.spec["metrics"])
         runs = records[records["method"] == spec["method"]]
         keyed = runs.set_index(["data_condition", "repetition"])
-        chosen_label = str(spec["chosen"])
-        chosen = keyed[keyed["condition"] == chosen_label][metrics]
+        labels = self.conditions(runs)  # the chosen one (each, where the mapping picks several)
         found = []
-        for other, rows in keyed[keyed["condition"] != chosen_label].groupby("condition", sort=False):
-            both = chosen.merge(rows[metrics], left_index=True, right_index=True, suffixes=("", " (other)")).dropna()
-            if len(both) < INFERENCE.min_runs:
-                continue
-            tested = dominance(both[metrics].to_numpy(), both[[f"{m} (other)" for m in metrics]].to_numpy())
-            gains = ", ".join(f"{m} {g:+.3g}" for m, g in zip(metrics, tested.gains))
-            verdict = _threshold_verdict(_finite(tested.p_for), _finite(tested.p_against), f"{other} is better on both")
-            found.append(Check(f"{chosen_label} against {other} (the other minus the chosen: {gains})", verdict,
-                               timed=any(quantity(m).machine_dependent for m in metrics)))
+        for chosen_label in labels:
+            chosen = keyed[keyed["condition"] == chosen_label][metrics]
+            for other, rows in keyed[~keyed["condition"].isin(labels)].groupby("condition", sort=False):
+                both = chosen.merge(rows[metrics], left_index=True, right_index=True, suffixes=("", " (other)")).dropna()
+                if len(both) < INFERENCE.min_runs:
+                    continue
+                tested = dominance(both[metrics].to_numpy(), both[[f"{m} (other)" for m in metrics]].to_numpy())
+                gains = ", ".join(f"{m} {g:+.3g}" for m, g in zip(metrics, tested.gains))
+                verdict = _threshold_verdict(_finite(tested.p_for), _finite(tested.p_against),
+                                             f"{other} is better on both")
+                found.append(Check(f"{chosen_label} against {other} (the other minus the chosen: {gains})", verdict,
+                                   timed=any(quantity(m).machine_dependent for m in metrics)))
         return found
 
 
@@ -725,7 +743,18 @@ def _paper(path: Path) -> tuple[int, Paper]:
               note=c.get("note", ""), untestable=c.get("untestable", ""))
         for c in data["claims"]
     )
-    return data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims)
+    for claim in claims:  # a condition written as a label is refused here, in its file's name
+        for reading in claim.readings:
+            named(reading.test, f"{path}: claim {claim.id}, reading {reading.name}")
+    return data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims, path)
+
+
+def named(spec: dict, where: str = "a claim's reading") -> list[dict]:
+    """The conditions a reading names (``conditions:``, a threshold's ``condition:``, a pareto's ``chosen:``),
+    each a mapping of variables to values that picks every condition taking them
+    (:mod:`~replication.evidence.named_conditions`): each condition picked is a check of its own, as each
+    condition is where the reading names none."""
+    return [condition for key in NAMING for condition in as_mappings(spec.get(key), where)]
 
 
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table],

@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from replication.evidence.aggregate import sequence_seen
+from replication.evidence.named_conditions import as_mappings, matching
 from replication.metrics import tracking as tm
 
 
@@ -52,8 +53,19 @@ def curve_table(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataF
     """The table figure ``spec`` (a kind in :data:`CURVES`) draws, from the runs of its ``conditions``
     (all, if it names none); empty if none of them was run."""
     if "conditions" in spec:
-        records = records[records["condition"].isin(spec["conditions"])]
+        records = records[figure_runs(records, spec)]
     return CURVES[spec["kind"]](records, spec, experiment) if len(records) else pd.DataFrame()
+
+
+def figure_conditions(spec: dict) -> list[dict]:
+    """The ``conditions`` figure ``spec`` is drawn at, each a mapping of values
+    (:mod:`~replication.evidence.named_conditions`); none: every condition."""
+    return as_mappings(spec.get("conditions"), f"figure {spec.get('name', spec.get('kind'))!r}: conditions")
+
+
+def figure_runs(records: pd.DataFrame, spec: dict) -> pd.Series:
+    """Which of ``records`` figure ``spec`` draws, where it names ``conditions``: the runs at one of them."""
+    return matching(records, *figure_conditions(spec))
 
 
 @curve("per_frame_curve")

@@ -19,7 +19,7 @@ import pandas as pd
 import yaml
 
 from replication.evidence.schema import Summary
-from replication.evidence.tables import KEYS, CellResult
+from replication.evidence.tables import KEYS, CellResult, matched
 from replication.paths import CONF_DIR, experiment_names
 
 # -- the summary of every published cell --------------------------------------------------------------
@@ -204,7 +204,7 @@ def _why_not(cell: pd.Series, summaries: dict, configs: dict, scene_notes: dict)
     config = configs[name]
     if cell["method"] not in config.get("methods", {}):
         return Unmatched("method not reproduced", f"{cell['method']} is not among {name}'s methods"), name
-    wanted = [m if isinstance(m, dict) else {"condition": m} for m in spec.get("match", {}).values()]
+    wanted = [paper for _, paper in matched(spec)]
     scenes = {str(m["experiment"]) for m in wanted if "experiment" in m}
     if scenes and cell["experiment"] not in scenes:
         note = scene_notes.get((cell["paper"], cell["experiment"]), "")

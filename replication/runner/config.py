@@ -16,6 +16,7 @@ before any work starts, and errors are one line that names the bad key.
 import hashlib
 import itertools
 import json
+from collections.abc import Iterator
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
@@ -62,10 +63,10 @@ def _run_key(task: str, model: dict, method: dict, base_seed: int, code: str) ->
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
 
 
-def experiment_at_scale(cfg: DictConfig) -> dict:
-    """``cfg.experiment`` as plain data at ``cfg.scale``, its real sequences located (``data.*``,
-    ``sequences=``: :mod:`replication.runner.sequences`): what the runs and the report both read."""
-    experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale)
+def experiment_at_scale(cfg: DictConfig, scale: str | None = None) -> dict:
+    """``cfg.experiment`` as plain data at ``scale`` (by default ``cfg.scale``), its real sequences located
+    (``data.*``, ``sequences=``: :mod:`replication.runner.sequences`): what the runs and the report both read."""
+    experiment = at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), scale or cfg.scale)
     return locate_sequences(experiment, cfg.get("data"), cfg.get("sequences"))
 
 
@@ -91,18 +92,50 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
         raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
     task = TASKS[exp.task]
     experiment = experiment_at_scale(cfg)
+    scenes = experiment.get("scenes", {})
+    runs, skipped = [], [] if skipped is None else skipped
+    codes: dict[str, str] = {}  # filter name -> the digest of the code its runs execute
+    for method, condition, data_condition, run_model, run_params in planned(experiment):
+        builder(run_params["filter"])
+        if "scene" in run_model:
+            if run_model["scene"] not in scenes:
+                raise ConfigError(f"model.scene {run_model['scene']!r} is not in experiment.scenes {sorted(scenes)}")
+            run_model["scene_spec"] = scenes[run_model["scene"]]
+        try:
+            task.check(run_model, run_params)
+        except DataMissing as missing:
+            message = f"{exp.name}: {missing}"
+            if message not in skipped:
+                skipped.append(message)
+            continue
+        except (TypeError, ValueError, KeyError) as error:
+            where = f" ({condition})" if condition else ""
+            raise ConfigError(f"model{where}: {error}") from None
+        build_filter(method, run_params, str(condition))
+        if run_params["filter"] not in codes:  # a filter's code is digested once, not once per swept value
+            codes[run_params["filter"]] = method_code_digest(task, builder(run_params["filter"]))
+        key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed), codes[run_params["filter"]])
+        runs.extend(
+            Run(exp.name, exp.task, method, condition, r, run_model, run_params, int(cfg.base_seed), key,
+                data_condition)
+            for r in range(repetitions)
+        )
+    return runs
+
+
+def planned(experiment: dict) -> Iterator[tuple[str, Condition, Condition, dict, dict]]:
+    """Each method's conditions as ``experiment`` (plain data at a scale) sweeps them, before any data or
+    filter is looked at: ``(method, condition, data condition, model, parameters)`` for each product of the
+    model's and the method's swept values that the method's ``only:`` keeps."""
     model = dict(experiment["model"])
     model_sweeps = _sweeps(model, True, "model")
-    scenes = experiment.get("scenes", {})
     methods = experiment["methods"]
     if not methods:
         raise ConfigError("experiment.methods is empty")
-    runs, skipped = [], [] if skipped is None else skipped
-    codes: dict[str, str] = {}  # filter name -> the digest of the code its runs execute
     for method, params in methods.items():
         if "filter" not in params:
             raise ConfigError(f"method {method!r}: no 'filter:' key (a registered name or module:name)")
-        builder(params["filter"])
+        params = dict(params)
         sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
         only = params.pop("only", None) or {}  # e.g. {scene: [exp1_3123]}: a method run on some conditions only
         observation = params.pop("observation", None) or {}  # e.g. fusion_pf's colour-only filter: {alpha: 1}
@@ -112,35 +145,9 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
                 run_model["observation"] = {**model.get("observation", {}), **observation}
             for (on_model, name, _), value in zip(sweeps, values):
                 _set(run_model if on_model else run_params, name, value)
+            if any(run_model.get(k, run_params.get(k)) not in allowed for k, allowed in only.items()):
+                continue
             condition = Condition.of((name, value) for (_, name, _), value in zip(sweeps, values))
             data_condition = Condition.of((name, value) for (on_model, name, _), value in zip(sweeps, values)
                                           if on_model)
-            if any(run_model.get(k, run_params.get(k)) not in allowed for k, allowed in only.items()):
-                continue
-            if "scene" in run_model:
-                if run_model["scene"] not in scenes:
-                    raise ConfigError(f"model.scene {run_model['scene']!r} is not in experiment.scenes {sorted(scenes)}")
-                run_model["scene_spec"] = scenes[run_model["scene"]]
-            try:
-                task.check(run_model, run_params)
-            except DataMissing as missing:
-                message = f"{exp.name}: {missing}"
-                if message not in skipped:
-                    skipped.append(message)
-                continue
-            except (TypeError, ValueError, KeyError) as error:
-                where = f" ({condition})" if condition else ""
-                raise ConfigError(f"model{where}: {error}") from None
-            build_filter(method, run_params, str(condition))
-            if run_params["filter"] not in codes:  # a filter's code is digested once, not once per swept value
-                codes[run_params["filter"]] = method_code_digest(task, builder(run_params["filter"]))
-            key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed), codes[run_params["filter"]])
-            runs.extend(
-                Run(exp.name, exp.task, method, condition, r, run_model, run_params, int(cfg.base_seed), key,
-                    data_condition)
-                for r in range(repetitions)
-            )
-    return runs
-
-
-
+            yield method, condition, data_condition, run_model, run_params

@@ -72,15 +72,15 @@ def own_sequences(scenes: dict, sequences: list[str] | str, roots: dict[str, str
 
 def follow_sequences(report: dict, replaced: set[str], scenes: list[str]) -> dict:
     """A report spec whose figures and tables named a replaced scene drawn for the user's ``scenes`` instead:
-    ``conditions: [scene=...]`` for each of them, a one-scene figure's ``scene:`` (a video) for the first;
+    ``conditions: [{scene: ...}]`` for each of them, a one-scene figure's ``scene:`` (a video) for the first;
     one naming only kept scenes stays as it is."""
     def moved(spec: dict) -> dict:
         if spec.get("scene") in replaced:
             spec = {**spec, "scene": scenes[0]}
-        named = [c for c in spec.get("conditions", []) if c.removeprefix("scene=") in replaced]
+        named = [c for c in spec.get("conditions", []) if isinstance(c, dict) and c.get("scene") in replaced]
         if not named:
             return spec
-        return {**spec, "conditions": [f"scene={name}" for name in scenes]}
+        return {**spec, "conditions": [{"scene": name} for name in scenes]}
 
     return {**report, **{part: [moved(spec) for spec in report.get(part, [])] for part in ("tables", "figures")
                          if part in report}}

@@ -2,8 +2,9 @@
 
 Each raises :class:`ConfigError` with one line naming the bad key: a value of
 the wrong type for the filter it goes to, an unknown ``parallel.*`` key or
-backend, an OTB scene whose folder does not exist.  :func:`prepare` runs them
-all and expands the experiment into its runs.
+backend, an OTB scene whose folder does not exist, a condition a table, a
+figure or a claim names that no run of the experiment has.  :func:`prepare`
+runs them all and expands the experiment into its runs.
 """
 
 import inspect
@@ -12,13 +13,18 @@ import typing
 
 from omegaconf import DictConfig, OmegaConf
 
+from replication.condition import Condition
 from replication.errors import ConfigError
+from replication.evidence.curves import figure_conditions
+from replication.evidence.named_conditions import holds, written
+from replication.evidence.tables import matched
 from replication.filters.registry import builder
-from replication.paths import resolve
+from replication.paths import experiment_names, resolve
 from replication.run import Run
-from replication.runner.config import expand
+from replication.runner.config import expand, experiment_at_scale, planned
 from replication.scales import at_scale
 from replication.runner.execute import BackendError, check_backend
+from replication.runner.variant import as_shipped
 
 RESERVED_METHOD_KEYS = ("filter", "label", "sweep", "only", "observation")  # read by expand, not by the filter
 PARALLEL_KEYS = ("backend", "address")
@@ -138,6 +144,7 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
 
         load_own_papers(resolve(str(cfg.claims_dir)))
     check_scenes(cfg)
+    check_conditions(cfg)
     skipped: list[str] = []
     runs = expand(cfg, skipped)
     if not runs:
@@ -148,10 +155,70 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
 
 
 def tables_without_runs(cfg: DictConfig, runs: list[Run]) -> list[str]:
-    """A line for each report table whose conditions (the keys of its ``match:``) no run of this request
+    """A line for each report table whose conditions (those its ``match:`` lists) no run of this request
     has (bis_pf run without its 3123 scene): said before any work, the page then leaves the table out."""
     tables = OmegaConf.to_container(cfg.experiment, resolve=True).get("report", {}).get("tables", [])
-    ran = {str(run.condition) for run in runs}
-    return [f"{cfg.experiment.name}: table {spec['name']} needs {' or '.join(spec['match'])}, which no run of "
-            f"this request has: its page will leave it out" for spec in tables
-            if spec.get("match") and not ran & set(spec["match"])]
+    ran = list({str(run.condition): run.condition for run in runs}.values())
+    lines = []
+    for spec in tables:
+        wanted = [condition for condition, _ in matched(spec)]
+        if wanted and not _held(ran, wanted):
+            lines.append(f"{cfg.experiment.name}: table {spec['name']} needs {' or '.join(map(written, wanted))}, "
+                         "which no run of this request has: its page will leave it out")
+    return lines
+
+
+def named_conditions(cfg: DictConfig) -> list[tuple[str, dict]]:
+    """Each condition the experiment's report tables (``match:``) and figures (``conditions:``) name, and the
+    claims' readings of it (the papers', and a user's own in ``claims_dir``), with where it is written."""
+    from replication.evidence.claims import load_own_papers, load_papers, named
+
+    name = cfg.experiment.name
+    file = f"experiment/{name}.yaml"
+    report = OmegaConf.to_container(cfg.experiment, resolve=True).get("report") or {}
+    try:  # a label is refused here, in the file's name
+        found = [(f"{file}: table {spec.get('name')!r}: match", condition)
+                 for spec in report.get("tables", []) for condition, _ in matched(spec)]
+        found += [(f"{file}: figure {spec.get('name')!r}: conditions", condition)
+                  for spec in report.get("figures", []) for condition in figure_conditions(spec)]
+    except ConfigError as error:
+        raise ConfigError(f"{file}: {error}") from None
+    papers = load_papers() + (load_own_papers(resolve(str(cfg.claims_dir))) if cfg.get("claims_dir") else ())
+    return found + [(f"{paper.path}: claim {claim.id}, reading {reading.name}", condition)
+                    for paper in papers for claim in paper.claims for reading in claim.readings
+                    if reading.experiment == name for condition in named(reading.test)]
+
+
+def check_conditions(cfg: DictConfig) -> None:
+    """Every condition :func:`named_conditions` gives holds for some run of the experiment: at this
+    request's scale or at paper scale, as requested or as shipped (a narrowed sweep, the quick scale or a
+    sequence not on this machine may leave a named condition without runs: its table, figure or check is
+    then left out, and said).  One that holds for none (a typo, a value no sweep takes) is one line naming
+    where it is written and the values each variable takes."""
+    named = named_conditions(cfg)
+    scales = dict.fromkeys([cfg.scale, "paper"])
+    known = [c for scale in scales for _, c, *_ in planned(experiment_at_scale(cfg, scale))]
+    missing = [(where, wanted) for where, wanted in named if not _held(known, [wanted])]
+    if missing and cfg.experiment.name in experiment_names():  # as shipped: a request may narrow its sweeps
+        known += [c for _, c, *_ in planned(experiment_at_scale(as_shipped(cfg.experiment.name, "paper")))]
+        missing = [(where, wanted) for where, wanted in missing if not _held(known, [wanted])]
+    if missing:
+        where, wanted = missing[0]
+        raise ConfigError(f"{where}: {written(wanted)} matches no run of {cfg.experiment.name}; {_values(known)}")
+
+
+def _held(conditions: list[Condition], wanted: list[dict]) -> bool:
+    """Whether one of ``wanted`` holds for one of ``conditions``."""
+    return any(holds(c.columns(), w) for c in conditions for w in wanted)
+
+
+def _values(conditions: list[Condition]) -> str:
+    """The values each variable takes in ``conditions``, for a message."""
+    taken: dict[str, list] = {}
+    for condition in conditions:
+        for variable, value in condition.values:
+            if value not in taken.setdefault(variable, []):
+                taken[variable].append(value)
+    if not taken:
+        return "it sweeps nothing: name no condition"
+    return "its runs take " + "; ".join(f"{v}: {', '.join(map(str, values))}" for v, values in taken.items())

@@ -34,7 +34,7 @@ def differences(cfg: DictConfig) -> list[str]:
     if cfg.experiment.name not in experiment_names():  # a --config-dir's (Hydra would compose it from there)
         return [f"experiment {cfg.experiment.name}: not one the package ships"]
     try:
-        shipped = experiment_at_scale(_shipped(cfg.experiment.name, cfg.scale))
+        shipped = experiment_at_scale(as_shipped(cfg.experiment.name, cfg.scale))
     except (HydraException, OmegaConfBaseException):  # renamed inside its file: not the package's
         return [f"experiment {cfg.experiment.name}: not one the package ships"]
     ours = experiment_at_scale(cfg)
@@ -70,7 +70,8 @@ def report_name(cfg: DictConfig, changes: list[str]) -> str:
     return f"{name}@{label}"
 
 
-def _shipped(name: str, scale: str) -> DictConfig:
+def as_shipped(name: str, scale: str) -> DictConfig:
+    """The config of the shipped experiment ``name`` at ``scale``, composed without the request's overrides."""
     overrides = [f"experiment={name}", f"scale={scale}"]
     if GlobalHydra.instance().is_initialized():  # inside the run command or the report's composition
         return compose("config", overrides=overrides)

@@ -8,7 +8,8 @@ import pandas as pd
 from replication.evidence.aggregate import summarise
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import Estimate, paired_difference
-from replication.evidence.tables.table import SENSITIVITY, Table, TableKind, match
+from replication.evidence.named_conditions import matching
+from replication.evidence.tables.table import SENSITIVITY, Table, TableKind, match, matched
 from replication.evidence.verdict import Verdict, judge_value
 from replication.evidence.settings import INFERENCE
 
@@ -35,12 +36,12 @@ class Comparison(TableKind):
             floor_runs = floors.loc[floors["mean"].idxmin(), "values"] if len(floors) else None
             excess = excess_over_floor(records, floor)
         if spec.get("match"):  # the conditions the paper's table covers
-            ours = ours[ours["condition"].isin(list(spec["match"]))]
+            ours = ours[matching(ours, *(condition for condition, _ in matched(spec)))]
         theirs = self.theirs()
         rows, entries = [], []
         for _, row in ours.iterrows():
             estimate = Estimate(row["mean"], row["ci_low"], row["ci_high"], row["runs"], row["interval"])
-            hit = match(theirs, row["method"], row["condition"], spec)
+            hit = match(theirs, row["method"], row, spec)
             paper = float(hit["number"].iloc[0]) if len(hit) else math.nan
             def judged(tolerance: float) -> Verdict | None:
                 return judge_value(paper, row["values"], kind, spec.get("statistic", "mean"), spec.get("paper_runs"),

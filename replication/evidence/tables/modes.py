@@ -64,7 +64,7 @@ class Modes(TableKind):
             shares = runs_keeping_both_modes(group, self.spec, self.experiment)
             keeping = int((shares > 0.5).sum())
             estimate = proportion(keeping, len(shares))
-            hit = match(theirs, method, condition, self.spec)
+            hit = match(theirs, method, group.iloc[0], self.spec)
             paper = hit["value"].iloc[0] if len(hit) else ""
             ours = "success" if estimate.value > 0.5 else "failure"
             verdict = judge_band(paper, keeping, len(shares), self.BANDS) if paper else None

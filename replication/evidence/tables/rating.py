@@ -17,7 +17,7 @@ class Rating(TableKind):
         for (method, condition), group in records.groupby(["method", "condition"], sort=False):
             failures, runs = int(group[self.spec["metric"]].sum()), len(group)
             estimate = proportion(failures, runs)
-            hit = match(theirs, method, condition, self.spec)
+            hit = match(theirs, method, group.iloc[0], self.spec)
             paper = hit["value"].iloc[0] if len(hit) else ""
             ours = next(name for name, (low, high) in bands.items() if low <= estimate.value <= high)
             verdict = judge_band(paper, failures, runs, bands) if paper else None

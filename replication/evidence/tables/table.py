@@ -9,12 +9,15 @@ Add a kind by subclassing :class:`TableKind` in a module of this package with a
 new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
 """
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 import pandas as pd
 
+from replication.errors import ConfigError
+from replication.evidence.named_conditions import as_mapping, holds, instead_of, written
 from replication.evidence.published import cells
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
@@ -121,22 +124,41 @@ def _estimate_columns(frame: pd.DataFrame) -> list[str]:
     return [c for c in frame.columns if len(frame) and all(isinstance(v, Estimate) for v in frame[c])]
 
 
-def match(theirs: pd.DataFrame, method: str, condition: str, spec: dict) -> pd.DataFrame:
-    """The published cells our row (``method``, ``condition``) is compared with.
+def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: dict) -> pd.DataFrame:
+    """The published cells our row (``method``, at the condition of ``ours``: a row with its label
+    ``condition`` and its ``condition.<variable>`` columns) is compared with.
 
-    ``spec.match`` maps a condition of ours to the paper's: a condition
-    string, or ``{experiment: scene, condition: ...}``; an unmapped condition
-    is compared with the paper's of the same name.  A paper cell with no
-    condition takes ``spec.paper_condition`` (the paper's unstated N, say).
+    ``spec.match`` lists conditions of ours, each with the paper's cells it is
+    compared with (:func:`matched`); a condition it does not list is compared
+    with the paper's of the same label.  A paper cell with no condition takes
+    ``spec.paper_condition`` (the paper's unstated N, say).
     """
-    wanted = spec.get("match", {}).get(condition, {"condition": condition})
-    wanted = wanted if isinstance(wanted, dict) else {"condition": wanted}
+    wanted = next((paper for condition, paper in matched(spec) if holds(ours, condition)),
+                  {"condition": ours["condition"]})
     chosen = theirs["method"] == method
     if "condition" in wanted:
         chosen &= theirs["condition"].replace("", spec.get("paper_condition", "")) == wanted["condition"]
     if "experiment" in wanted:
         chosen &= theirs["experiment"] == wanted["experiment"]
     return theirs[chosen]
+
+
+def matched(spec: dict) -> list[tuple[dict, dict]]:
+    """A table's ``match:``, each entry ``{ours: {scene: Girl}, paper: {experiment: single_object, condition:
+    "N=10;runs=100"}}``: a condition of ours (a mapping of values,
+    :mod:`~replication.evidence.named_conditions`) and the paper's cells it is compared with, by their
+    experiment and their condition as ``published_values.csv`` writes it (the paper's, not ours)."""
+    entries = spec.get("match") or []
+    where = f"table {spec.get('name')!r}: match"
+    if isinstance(entries, Mapping):  # keyed by our condition's label
+        label, paper = next(iter(entries.items()))
+        paper = written(paper if isinstance(paper, Mapping) else {"condition": paper})
+        raise ConfigError(f"{where} is a list: write {label!r} as - {{ours: {instead_of(str(label))}, paper: {paper}}}")
+    for entry in entries:
+        if not isinstance(entry, Mapping) or not isinstance(entry.get("paper"), Mapping):
+            raise ConfigError(f"{where}: an entry is {{ours: {{scene: Girl}}, paper: {{experiment: girl, condition: "
+                              f"N=10}}}}, got {entry!r}")
+    return [(as_mapping(entry.get("ours"), where), dict(entry["paper"])) for entry in entries]
 
 
 class TableKind:

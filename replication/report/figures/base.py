@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication.evidence.curves import CURVES, curve_table
+from replication.evidence.curves import CURVES, curve_table, figure_runs
+from replication.evidence.named_conditions import written
 from replication.evidence.published import COLUMNS
 from replication.report.figures.style import NothingToDraw
 
@@ -41,13 +42,14 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
         if absent:  # runs read from the paper-scale record, which keeps no per-frame series a table does not need
             raise NothingToDraw(f"figure {spec.get('name', kind)!r}: drawn from each run's {', '.join(absent)}, "
                                 "which these records do not hold")
-        if "conditions" in spec and not records["condition"].isin(spec["conditions"]).any():
+        if "conditions" in spec and not figure_runs(records, spec).any():
             # a scene the figure needs was not run (dropped by an override, say)
-            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: no runs at conditions {spec['conditions']}")
+            shown = ", ".join(written(c) for c in spec["conditions"])
+            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: no runs at conditions {shown}")
         if kind in CURVES:
             curve = curve_table(records, spec, experiment)
         elif "conditions" in spec:
-            records = records[records["condition"].isin(spec["conditions"])]
+            records = records[figure_runs(records, spec)]
     drawn = curve if kind in CURVES else records
     if "paper_table" not in spec:
         return KINDS[kind](drawn, spec, experiment, path)
