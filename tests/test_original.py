@@ -177,3 +177,4 @@ def test_the_interval_shown_is_the_one_each_test_decides_by():
     assert check.estimate.high == pytest.approx(-float(tested.gain.low))  # the direction's bound
     assert check.estimate.low > -2.6 and Result.of([check]).verdict.outcome is Outcome.NOT_REPRODUCED
     assert "with the paper's own noise (runs not stated: taken as ours, 20)" in check.estimate.method
+    assert check.estimate.level == pytest.approx(1 - INFERENCE.alpha - INFERENCE.size_alpha)  # 95 % and 97 % ends

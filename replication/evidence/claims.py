@@ -424,7 +424,7 @@ def _shown(tested: OrderTest, factor: float, runs: int, allowed: float, span: fl
     sized = bound is not test
     return Estimate((float(test.value) - allowed) * factor, *map(float, ends), runs,
                     f"paired {test.method}" + (f"; its end on the paper's side {bound.method}" if sized else ""),
-                    1 - INFERENCE.alpha - (INFERENCE.size_alpha if sized else INFERENCE.alpha))
+                    1 - INFERENCE.alpha - INFERENCE.size_alpha if sized else 1 - 2 * INFERENCE.alpha)
 
 
 def _allowing(verdict: Verdict, difference: Estimate, line: float, baseline: float, unit: str) -> Verdict:
