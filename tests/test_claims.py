@@ -366,8 +366,8 @@ def test_each_check_shows_the_interval_of_the_level_it_names():
                              EXPERIMENT).checks(sizes, {})
     a = sizes[sizes["method"] == "A"]
     fit = stats.linregress(np.log(4.0 + a["repetition"]), np.log(a["rmse"]))
-    assert growth.estimate.high == pytest.approx(fit.slope + stats.t.ppf(0.95, len(a) - 2) * fit.stderr)
-    assert growth.number.endswith(" (90% CI)")
+    assert growth.estimate.high == pytest.approx(fit.slope + stats.t.ppf(1 - INFERENCE.growth_alpha, len(a) - 2) * fit.stderr)
+    assert growth.number.endswith(" (92% CI)")  # each end the one-sided bound at growth_alpha
     published = pd.DataFrame({"paper": ["p"], "table": ["1"], "experiment": ["s"], "method": ["B vs A"],
                               "metric": ["rmse_improvement"], "condition": [""], "value": ["1.8"], "unit": ["%"],
                               "note": [""], "number": [1.8]})

@@ -9,6 +9,7 @@ from scipy import stats
 from conftest import typed
 from replication.evidence.claims import ClaimTest, Result
 from replication.evidence.trends import dominance, log_log_slope
+from replication.evidence.settings import INFERENCE
 from replication.evidence.verdict import Outcome
 
 EXPERIMENT = {"name": "t", "scenes": {}}
@@ -26,10 +27,11 @@ def test_the_log_log_slope_is_scipys_least_squares_on_logs_with_its_t_test():
     fit = stats.linregress(np.log(x), np.log(y))
     t = (fit.slope - 1.5) / fit.stderr
     assert slope.value == pytest.approx(fit.slope)
-    assert slope.p_below == pytest.approx(stats.t.cdf(t, len(x) - 2))
-    assert slope.p_above == pytest.approx(stats.t.sf(t, len(x) - 2))
+    corrected = INFERENCE.alpha / INFERENCE.growth_alpha  # each side at the size-corrected level, said on the 5 % scale
+    assert slope.p_below == pytest.approx(min(1.0, stats.t.cdf(t, len(x) - 2) * corrected))
+    assert slope.p_above == pytest.approx(min(1.0, stats.t.sf(t, len(x) - 2) * corrected))
     assert slope.low < fit.slope < slope.high
-    assert slope.high == pytest.approx(fit.slope + stats.t.ppf(0.95, len(x) - 2) * fit.stderr)
+    assert slope.high == pytest.approx(fit.slope + stats.t.ppf(1 - INFERENCE.growth_alpha, len(x) - 2) * fit.stderr)
 
 
 def _growth_records(exponent: float) -> pd.DataFrame:

@@ -643,7 +643,7 @@ class Growth(ClaimTest):
         what = f"{spec['method']}: growth exponent of {spec['metric']} in {spec['x']} ({len(set(x[kept]))} values)"
         verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec['x']}^{spec['at_most']:g}")
         shown = Estimate(float(slope.value), float(slope.low), float(slope.high), slope.points,
-                         "least squares on logs, t", 1 - 2 * INFERENCE.alpha)
+                         "least squares on logs, t", 1 - 2 * INFERENCE.growth_alpha)
         return [Check(what, verdict, shown, reference=float(spec["at_most"]), paper=float(spec["at_most"]),
                       timed=quantity(spec["metric"]).machine_dependent)]
 

@@ -20,6 +20,7 @@ class Inference:
     power: float  # the power at which the smallest detectable effect is quoted
     equivalence_alpha: float  # each side of the t-based equivalence test of a published mean
     size_alpha: float  # the test of ours against the paper's size, the paper's own noise estimated from ours
+    growth_alpha: float  # each side of the t-test of a growth exponent (least squares on logs)
     tolerance: float  # a published number is reproduced within +-tolerance of it where its table states none
     min_runs: int  # no verdict from fewer runs
     min_sequences: int  # no ranking verdict over fewer sequences
@@ -45,9 +46,10 @@ def configure(values) -> Inference:
     if unknown:
         raise ConfigError(f"inference: unknown setting(s) {sorted(unknown)}; known: {sorted(known)}")
     chosen = {**INFERENCE.as_dict(), **{k: (int if known[k] is int else float)(v) for k, v in values.items()}}
-    if not all(0 < chosen[k] < 1 for k in ("alpha", "level", "power", "equivalence_alpha", "size_alpha", "tolerance")):
-        raise ConfigError("inference: alpha, level, power, equivalence_alpha, size_alpha and tolerance lie strictly "
-                          "in (0, 1)")
+    if not all(0 < chosen[k] < 1 for k in ("alpha", "level", "power", "equivalence_alpha", "size_alpha", "growth_alpha",
+                                           "tolerance")):
+        raise ConfigError("inference: alpha, level, power, equivalence_alpha, size_alpha, growth_alpha and tolerance "
+                          "lie strictly in (0, 1)")
     if chosen["min_runs"] < 2 or chosen["min_sequences"] < 2 or chosen["bootstrap_resamples"] < 1:
         raise ConfigError("inference: min_runs and min_sequences are at least 2, bootstrap_resamples at least 1")
     for name, value in chosen.items():
@@ -81,7 +83,9 @@ def rules() -> tuple[str, ...]:
         "paper's size absent) survives Holm's correction across the reading's checks; else inconclusive, with the "
         f"smallest effect the runs detect at {_percent(s.power)} power.",
         "A bound (frames per second, say): the exact sign test of the median, the exact binomial test of a rate, the "
-        "t-test of a mean. 'X is best': X against each competitor, the paired t-test over the sequences, reproduced "
+        "t-test of a mean. A growth exponent (time against the number of targets, on logs): the t-test of the "
+        f"least-squares slope at {_percent(s.growth_alpha)} each side, so that skewed noise holds {_percent(s.alpha)}. "
+        "'X is best': X against each competitor, the paired t-test over the sequences, reproduced "
         "when it beats all and not reproduced when one is better after Holm; P(best) describes and decides nothing.",
         f"A published number counts as ours within +-{_percent(s.tolerance)} of it unless its table states another "
         "tolerance: reproduced only where equivalence is shown (two one-sided t-tests, each at "

@@ -18,8 +18,8 @@ from replication.evidence.settings import INFERENCE
 
 @dataclass(frozen=True)
 class Slope:
-    """The least-squares slope of log(value) on log(x) over every run, with its 90 % t interval (each bound the
-    one-sided 95 % bound) and the one-sided p-values of the true slope lying below (``p_below``) and above
+    """The least-squares slope of log(value) on log(x) over every run, with its t interval (each bound the
+    one-sided bound at ``INFERENCE.growth_alpha``) and the one-sided p-values of the true slope lying below (``p_below``) and above
     (``p_above``) the ``bound`` tested; arrays over leading batch axes."""
 
     value: np.ndarray
@@ -34,7 +34,9 @@ def log_log_slope(x, values, bound: float) -> Slope:
     """The growth exponent b of ``values`` ~ a x^b (ordinary least squares on logs, one point per run; last
     axis: the points, leading axes a batch), tested against ``bound``: b < bound (p_below) and b > bound
     (p_above), Student's t with n - 2 degrees of freedom and the slope's usual standard error (what
-    scipy.stats.linregress gives for one set); undefined (NaN) where the points fit a line exactly."""
+    scipy.stats.linregress gives for one set), each side at the size-corrected level ``INFERENCE.growth_alpha``
+    (its p-values said on the 5 % scale, times alpha / growth_alpha, and the interval's ends its one-sided
+    bounds); undefined (NaN) where the points fit a line exactly."""
     x, y = np.log(np.asarray(x, dtype=float)), np.log(np.asarray(values, dtype=float))
     n = y.shape[-1]
     dx = x - x.mean(axis=-1, keepdims=True)
@@ -45,9 +47,11 @@ def log_log_slope(x, values, bound: float) -> Slope:
     defined = (n > 2) & (se > 1e-12 * np.maximum(1.0, np.abs(slope)))
     with np.errstate(all="ignore"):
         t = np.where(defined, (slope - bound) / se, np.nan)
-        half = stats.t.ppf(1 - INFERENCE.alpha, max(n - 2, 1)) * se
+        half = stats.t.ppf(1 - INFERENCE.growth_alpha, max(n - 2, 1)) * se
+    scale = INFERENCE.alpha / INFERENCE.growth_alpha
     return Slope(slope, np.where(defined, slope - half, np.nan), np.where(defined, slope + half, np.nan),
-                 stats.t.cdf(t, max(n - 2, 1)), stats.t.sf(t, max(n - 2, 1)), n)
+                 np.minimum(1.0, stats.t.cdf(t, max(n - 2, 1)) * scale), np.minimum(1.0, stats.t.sf(t, max(n - 2, 1)) * scale),
+                 n)
 
 
 @dataclass(frozen=True)
