@@ -429,11 +429,12 @@ def _shown(tested: OrderTest, factor: float, runs: int, allowed: float, span: fl
 
 def _allowing(verdict: Verdict, difference: Estimate, line: float, baseline: float, unit: str) -> Verdict:
     """A check's verdict with the raw difference and the allowance it was tested against said apart, before
-    its own why: '+0.0266 ms (+55%), allowed +10% = +0.00482 ms: the other way round, p < 1e-4'
+    its own why: '+0.0266 ms (+55%), allowed +10% = +0.00482 ms: beyond the allowance, p < 1e-4'
     (``line``: the allowance as a difference better - worse; ``baseline``: the beaten method's mean)."""
     raw, relative = difference.value, difference.value / abs(baseline)
     said = f"{raw:+.3g}{unit} ({relative:+.0%}), allowed {line / abs(baseline):+.0%} = {line:+.3g}{unit}"
-    return replace(verdict, why=f"{said}: {verdict.why}" if verdict.why else said)
+    why = verdict.why.replace("the other way round", "beyond the allowance", 1)  # the line is the allowance, not 0
+    return replace(verdict, why=f"{said}: {why}" if why else said)
 
 
 def _order_verdict(tested: OrderTest, paper: Effect | None, unit: float, binary: bool) -> Verdict:
