@@ -288,8 +288,8 @@ class Order(ClaimTest):
 
     def effect(self, better: str, worse: str, ours: pd.Series, runs: int) -> Effect | None:
         """The paper's numbers for the pair at our condition (``ours``: a run's record there), matched with its
-        cells as our table named by ``size.table`` matches them (None where ``size`` names none, or a number is
-        missing), with the runs behind them by :func:`~replication.evidence.original.paper_runs` (``runs``:
+        cells as our table named by ``size.table`` matches them (a list: the first holding both; None where
+        ``size`` names none, or a number is missing), with the runs behind them by :func:`~replication.evidence.original.paper_runs` (``runs``:
         ours): the table's ``paper_runs`` where the paper states them (a user's ``size.runs``)."""
         size = self.spec.get("size")
         if size and "quoted" in size:  # a user's claim quoting its own numbers ({method: number}), no table
@@ -301,12 +301,15 @@ class Order(ClaimTest):
             return Effect(float(quoted[better]), float(quoted[worse]), behind, size.get("kind", "difference"))
         if not size or self.published is None:
             return None
-        table = next(t for t in self.experiment["report"]["tables"] if t["name"] == size["table"])
-        theirs = published_cells(self.published, self.experiment["paper"], table["paper_table"],
-                                 table.get("paper_metric", table.get("metric")))
-        methods = size.get("methods", {})
-        values = [match(theirs, str(methods.get(m, m)), ours, table)["number"] for m in (better, worse)]
-        if any(len(v) != 1 or not np.isfinite(v.iloc[0]) for v in values):
+        for name in _listed(size["table"]):  # the first of the named tables that holds both numbers here
+            table = next(t for t in self.experiment["report"]["tables"] if t["name"] == name)
+            theirs = published_cells(self.published, self.experiment["paper"], table["paper_table"],
+                                     table.get("paper_metric", table.get("metric")))
+            methods = size.get("methods", {})
+            values = [match(theirs, str(methods.get(m, m)), ours, table)["number"] for m in (better, worse)]
+            if all(len(v) == 1 and np.isfinite(v.iloc[0]) for v in values):
+                break
+        else:
             return None
         stated = table.get("paper_runs") if table.get("paper_runs_stated", True) else None
         printed = list(theirs.loc[theirs["number"].notna(), "value"])  # as printed: their precision
