@@ -121,8 +121,9 @@ class Recomputed:
     @property
     def same_machine(self) -> bool:
         """Computed here by the code paths and libraries that computed the recorded run (both known)."""
-        return (self.row.get("machine_detail") is not None and "failure" not in self.now
-                and Machine.of(self.row["machine_detail"]) == Machine.of(self.now["machine_detail"])
+        recorded, here = self.row.get("machine_detail"), self.now.get("machine_detail")
+        return (recorded is not None and here is not None and set(recorded) == set(here)
+                and Machine.of(recorded) == Machine.of(here)
                 and all(self.row.get(k) == self.now.get(k) for k in LIBRARIES))
 
     @property
@@ -360,7 +361,8 @@ def substituted(record: Path, runs: list[Recomputed], out: Path) -> list[str]:
     for path in sorted(p for p in out.rglob("*.parquet") if CURVES_DIR not in p.parts):
         names = [c for c in pq.read_schema(path).names if c in ("experiment", "method", "repetition", "run_key")
                  or c.startswith(PREFIX)]
-        keys = [(r["experiment"], row_identity(r), r["run_key"]) for r in pq.read_table(path, columns=names).to_pylist()]
+        held = pq.read_table(path, columns=names).to_pylist()
+        keys = [(r["experiment"], row_identity(r), r["run_key"]) for r in held]
         if not by_key.keys() & set(keys):
             continue
         rows = [_in_place(r, by_key[key]) if key in by_key else r for r, key in zip(read_rows(path), keys)]
