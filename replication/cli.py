@@ -5,10 +5,11 @@ entry point.
 ``report`` redraws reports from stored runs (:mod:`replication.report.__main__`); ``scenes`` writes
 an experiment's synthetic scenes as video (:mod:`replication.scenes.__main__`); ``export`` writes a
 tracking experiment's runs in the OTB and GOT-10k toolkits' result layouts (:mod:`replication.export`);
-``record`` writes the paper-scale record from the store and ``verify`` re-computes a sample of it
-(:mod:`replication.record`); ``diff A B`` lists the claims and cells whose verdict or estimate differ
-between two records or reports (:mod:`replication.report.diff`); ``findings`` renders each paper's findings
-from the record into ``docs/findings/`` (:mod:`replication.report.findings`).
+``record`` writes the paper-scale record from the store and ``verify`` re-computes a sample of it,
+grades it (:mod:`replication.record`) and judges the verdicts again with it; ``diff A B`` lists the
+claims and cells whose verdict or estimate differ between two records or reports
+(:mod:`replication.report.diff`); ``findings`` renders each paper's findings from the record into
+``docs/findings/`` (:mod:`replication.report.findings`).
 
 Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
@@ -49,7 +50,7 @@ SUBCOMMANDS = {
     "scenes": "replication.scenes.__main__:main",
     "export": "replication.export:main",
     "record": "replication.record.__main__:main",
-    "verify": "replication.record.verify:main",
+    "verify": "replication.cli:verify",
     "diff": "replication.report.diff:main",
     "findings": "replication.report.__main__:findings",
 }
@@ -318,6 +319,15 @@ def run(argv: list[str]) -> None:
         fail(str(error))
     sys.argv = [sys.argv[0], *argv]  # Hydra reads the command line itself
     run_experiment()
+
+
+def verify(argv: list[str]) -> None:
+    """``pf-replicate verify ...``: the record's runs re-computed and graded (:mod:`replication.record.verify`),
+    then its verdicts judged again with them (:func:`replication.report.diff.verdicts`): above both layers."""
+    from replication.record.verify import main as recompute
+    from replication.report.diff import verdicts
+
+    recompute(argv, verdicts)
 
 
 def main(argv: list[str] | None = None) -> None:

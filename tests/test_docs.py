@@ -43,6 +43,13 @@ ALLOWED: dict[str, str] = {
                  "the venv included (6 min 56 s at 161a222, measured 2026-11-26)",
     "9 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
                  "(8 min 29 s at 161a222, measured 2026-11-26)",
+    # docs/reproducibility.md, how verify's tolerance was chosen (issue 56), measured 2026-11-27 at b6790c6 on
+    # the 2-core AMD EPYC (family 25, model 1): the largest relative difference of a score ...
+    "1.8e-14": "... between 75 quick runs as they are and with OpenBLAS's kernel masked (OPENBLAS_CORETYPE)",
+    "8.8e-7": "... between the same runs as they are and with OpenCV's vector paths masked (OPENCV_CPU_DISABLE)",
+    "5.9e-16": "... between the shipped record's quickest run of each experiment and universe and this machine's",
+    "3.5e-7": "... between the same recorded runs and this machine's with numpy's, numba's, OpenBLAS's and "
+              "OpenCV's vector paths masked",
 }
 
 

@@ -1,7 +1,9 @@
 """``record/manifest.json``: what made the record, and the SHA-256 of each of its files.
 
 One :class:`Entry` per experiment, read off its runs' own provenance: how many runs (and failed), the
-commits and code digests that computed them, the libraries and CPU, when the first and last were
+commits and code digests that computed them, the libraries and CPU and the code paths the libraries took
+on it (``machine_details``, :class:`~replication.runner.machine.Machine`: ``null`` where the runs were
+computed before they said, as every run of the record at f29efe1 was), when the first and last were
 computed and their summed wall time; and of its files, the SHA-256 of each and their size
 (:meth:`Manifest.damaged` names a file that no longer matches).  An entry that replaces another keeps
 what the one it replaced took (:class:`Before`), so that a change of code shows its cost beside the old.
@@ -12,6 +14,8 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+
+from replication.runner.machine import Machine
 
 MANIFEST = "manifest.json"
 PROFILE = "profile.json"  # where the time of the record's slowest experiments goes (benchmarks/profile_run.py)
@@ -50,6 +54,7 @@ class Entry:
     written: str  # the date the file was written
     universes: int = 0  # a multiverse's universes recorded (0: an experiment)
     before: Before | None = None  # the recording this entry replaced
+    machine_details: tuple[Machine, ...] | None = None  # the code paths of its runs' machines (None: not recorded)
 
     @property
     def minutes(self) -> float | None:
@@ -81,7 +86,8 @@ class Entry:
             code_digests=_distinct(rows, "code_digest"),
             libraries=tuple(sorted({", ".join(f"{k.removesuffix('_version')} {r.get(k)}" for k in LIBRARIES)
                                     for r in rows if not r.get("failure")})),
-            machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat(), universes=universes)
+            machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat(), universes=universes,
+            machine_details=_machines(rows))
 
 
 @dataclass(frozen=True)
@@ -96,7 +102,9 @@ class Manifest:
         if not path.exists():
             return cls({})
         data = json.loads(path.read_text())
-        entries = {name: Entry(**{**_tuples(entry), "before": entry.get("before") and Before(**_tuples(entry["before"]))})
+        entries = {name: Entry(**{**_tuples(entry),
+                                  "before": entry.get("before") and Before(**_tuples(entry["before"])),
+                                  "machine_details": _read_machines(entry.get("machine_details"))})
                    for name, entry in data["experiments"].items()}
         return cls(entries, data["scale"])
 
@@ -135,6 +143,16 @@ def sha256(path: Path) -> str:
 def _tuples(data: dict) -> dict:
     """JSON's lists back to the tuples written."""
     return {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
+
+
+def _machines(rows: list[dict]) -> tuple[Machine, ...] | None:
+    """The distinct machines the rows name (None where none does: runs computed before they said)."""
+    found = {Machine.of(r["machine_detail"]) for r in rows if r.get("machine_detail")}
+    return tuple(sorted(found, key=str)) or None
+
+
+def _read_machines(data: list[dict] | None) -> tuple[Machine, ...] | None:
+    return None if data is None else tuple(Machine.of(d) for d in data)
 
 
 def _distinct(rows: list[dict], key: str) -> tuple:

@@ -5,12 +5,14 @@ A and B are each a record folder (``record/``: its pages are drawn first, as ``r
 draws them), a drawn report folder (one holding ``claims.csv`` and ``summary.csv``: ``reports``,
 ``reports/record``), or ``store``: the runs in the store at the paper scale.  One line per changed claim
 (verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict), then
-the totals.
+the totals.  :func:`verdicts` compares the verdicts alone, of some experiments of two records:
+``pf-replicate verify``'s judgement of the runs it re-computed.
 """
 
+import io
 import sys
 import tempfile
-from contextlib import ExitStack
+from contextlib import ExitStack, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import pandas as pd
@@ -22,17 +24,21 @@ CLAIM = ("claim_id",)
 CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost")
 CELL = ("paper", "table", "experiment", "method", "metric", "condition")
 CELL_FIELDS = ("ours", "runs", "verdict", "reason")
+VERDICTS = {CLAIM: ("verdict", "robust", "at_equal_cost"), CELL: ("verdict",)}  # what must not move, by key
 
 
-def drawn(source: str, scratch: Path) -> Path:
-    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it first if need be."""
+def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs: int | None = None) -> Path:
+    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it first if need be
+    (of a record, only its ``experiments`` where named, on ``n_jobs`` workers where given)."""
     from replication.report.__main__ import main as report
 
     path = Path(source)
     if (path / "claims.csv").exists() and (path / "summary.csv").exists():
         return path
     if (path / MANIFEST).exists():
-        report(["source=record", f"record={path.resolve()}", f"reports={scratch}", "pdf=false"])
+        only = [f"experiment={','.join(experiments)}"] if experiments else []
+        workers = [f"n_jobs={n_jobs}"] if n_jobs else []
+        report(["source=record", f"record={path.resolve()}", f"reports={scratch}", "pdf=false", *only, *workers])
         return scratch / PAGES
     if source == "store":
         report(["scale=paper", f"reports={scratch}", "pdf=false"])
@@ -62,6 +68,24 @@ def line(name: str, moved: dict[str, tuple[str, str]]) -> str:
     if "only in" in moved:
         return f"{name}: only in {moved['only in'][0]}"
     return f"{name}: " + "; ".join(f"{f} {a or '-'!r} -> {b or '-'!r}" for f, (a, b) in moved.items())
+
+
+def verdicts(before: Path, after: Path, experiments: list[str], n_jobs: int = 2) -> list[str]:
+    """Each claim and published cell whose verdict differs between two records judged on their entries
+    ``experiments`` (each drawn as ``report source=record`` draws it), a line each; printed after the counts,
+    with how many estimates moved though their verdict held."""
+    with ExitStack() as stack, redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()):  # scratch pages
+        folders = [drawn(str(source), Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="verdicts-"))),
+                         tuple(experiments), n_jobs) for source in (before, after)]
+        tables = {key: [pd.read_csv(folder / name, dtype=str) for folder in folders]
+                  for key, name in ((CLAIM, "claims.csv"), (CELL, "summary.csv"))}
+    moved = [line(*change) for key, fields in VERDICTS.items() for change in changes(*tables[key], key, fields)]
+    estimates = [len(changes(*tables[key], key, (field,))) for key, field in ((CLAIM, "number"), (CELL, "ours"))]
+    judged = [int(tables[CLAIM][1]["scale"].notna().sum()), int(tables[CELL][1]["verdict"].notna().sum())]
+    print(f"verdicts: {judged[0]} claims and {judged[1]} published cells judged from them: {len(moved)} verdicts "
+          f"changed ({estimates[0]} claims' and {estimates[1]} cells' estimates moved)")
+    print(*moved, sep="\n", end="\n" if moved else "")
+    return moved
 
 
 def main(argv: list[str]) -> None:

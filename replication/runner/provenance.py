@@ -10,7 +10,8 @@ module it gathers.  :func:`code_digest` hashes every module that computes
 runs (all but :data:`READ_ONLY`: the evidence and report layers, the command
 line, the reader of stored records, the export of results for other
 toolkits): it goes into every record's provenance.
-:func:`provenance` is written into every record, and the report shows it.
+:func:`provenance` is written into every record, and the report shows it: beside the CPU's name, the code
+paths its libraries took on it (:class:`~replication.runner.machine.Machine`).
 """
 
 import ast
@@ -21,8 +22,11 @@ import importlib.util
 import inspect
 import platform
 import subprocess
+from dataclasses import asdict
 from functools import lru_cache
 from pathlib import Path
+
+from replication.runner.machine import machine
 
 PACKAGE = Path(__file__).resolve().parent.parent
 # what never computes a run (prefixes of paths inside the package): the evidence and report layers (deciding
@@ -177,22 +181,13 @@ def _environment() -> dict:
         **_git(),
         "python_version": platform.python_version(),
         **versions,
-        "machine": f"{platform.machine()} {_cpu()}".strip(),
+        "machine": f"{platform.machine()} {machine().cpu}".strip(),
     }
-
-
-def _cpu() -> str:
-    """The CPU's model name (Linux), else what the platform module knows."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
 
 
 def provenance() -> dict:
     """What a record says of where it came from: code digest, git commit and dirtiness (of the
-    package's tree), library versions, machine, and the UTC time it was computed."""
-    return {**_environment(), "computed_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+    package's tree), library versions, machine (its CPU's name, and in ``machine_detail`` the code paths
+    the libraries took on it), and the UTC time it was computed."""
+    return {**_environment(), "machine_detail": asdict(machine()),
+            "computed_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}

@@ -73,6 +73,9 @@ def recorded(reports: Path, papers: tuple[Paper, ...]) -> dict | None:
         "stale": {name: e for name, e in status["experiments"].items() if e["stale"]},
         "recomputed": None if again is None else {
             "runs": sum(e["compared"] for e in again.values()),
-            "differ": [line for e in again.values() for line in e["differ"]]},
+            **{grade: sum(e[grade] for e in again.values()) for grade in ("identical", "within", "diverged")},
+            "largest": max((e["largest"] for e in again.values()), default=0.0),
+            "lines": [line for e in again.values() for line in e["lines"]],
+            "beyond": [line for e in again.values() for line in e["beyond"]]},
         "claims": rows,
     }
