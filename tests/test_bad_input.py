@@ -293,4 +293,4 @@ def test_sequences_of_ones_own_run_through_a_mot_experiment_and_its_figures_foll
     for figure in ("snapshots", "identities", "video"):
         assert f'src="MyCampus/{figure}.png"' in sequence_page
         assert (folder / "sequences" / "MyCampus" / f"{figure}.png").stat().st_size > 5_000
-    assert "table1_time needs scene=exp6_pets09" in result.stderr  # the paper's timing table: said up front
+    assert "table1_time needs {scene: exp6_pets09}" in result.stderr  # the paper's timing table: said up front

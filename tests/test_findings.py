@@ -75,10 +75,11 @@ def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages)
 def _drawn(tmp_path: Path) -> Drawn:
     folder = tmp_path / "pages"
     (folder / "exp").mkdir(parents=True)
-    (folder / "claims.csv").write_text("paper,claim_id,claim,verdict,reason,number,ci_low,ci_high,level,runs,"
-                                       "deciding,robustness\np,p.a,A beats B,reproduced,2 of 2 checks hold,0.123456,"
-                                       "0.1,0.15,0.9,20,A - B,one reading\n"
-                                       "p,p.b,C beats D,not reproduced,a cell,0.5,0.25,0.75,0.95,10,C N=1,one reading\n")
+    (folder / "claims.csv").write_text("paper,claim_id,claim,quote_english,where,verdict,reason,number,ci_low,ci_high,"
+                                       "level,runs,deciding,robustness\np,p.a,A beats B,A is better than B,Table 1,"
+                                       "reproduced,2 of 2 checks hold,0.123456,0.1,0.15,0.9,20,A - B,one reading\n"
+                                       "p,p.b,C beats D,C is better than D,Table 2,not reproduced,a cell,0.5,0.25,0.75,"
+                                       "0.95,10,C N=1,one reading\n")
     (folder / "summary.csv").write_text("paper,table,method,condition,metric,paper_value,ours,runs,verdict\n"
                                         "p,1,A,N=1,rmse,4.2,4.25,20,reproduced\n")
     (folder / "exp" / "t.csv").write_text("method,condition,ours,ci_low,ci_high,failed runs\n"
@@ -106,10 +107,12 @@ def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path
     page = render(_drawn(tmp_path), tmp_path / "t")["p"]
     first, *tables = page.splitlines()
     assert first == "reproduced: 0.1235 [0.1, 0.15]; 12,346 0.5 [0.25, 0.75] 3; 1.25"
-    assert "| claim | verdict | deciding | estimate [interval] | runs | under every reading |" in tables
+    assert "| claim | the paper says | verdict | deciding | estimate [interval] | runs | under every reading |" in tables
     # each interval says its level: a one-sided test's 90 %, a published cell's 95 %
-    assert "| `p.a`: A beats B | **reproduced** | A - B | 0.1235 [0.1, 0.15] (90% CI) | 20 | one reading |" in tables
-    assert "| `p.b`: C beats D | **not reproduced** | C N=1 | 0.5 [0.25, 0.75] (95% CI) | 10 | one reading |" in tables
+    assert ("| `p.a`: A beats B | \u201cA is better than B\u201d (Table 1) | **reproduced** | A - B | 0.1235 [0.1, 0.15] (90% CI) "
+            "| 20 | one reading |") in tables
+    assert ("| `p.b`: C beats D | \u201cC is better than D\u201d (Table 2) | **not reproduced** | C N=1 | 0.5 [0.25, 0.75] "
+            "(95% CI) | 10 | one reading |") in tables
     assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
     assert "| `exp` | 40 |  | 1.25 | 2.5 | 2 min, 4 CPU-min (abc1234) |" in tables  # recorded again: what it took
     assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |  |" in tables  # a multiverse the record holds in part
