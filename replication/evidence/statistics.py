@@ -9,9 +9,7 @@
   per-attribute scores): the t interval with Welch-Satterthwaite degrees of freedom;
 * a median (timings): the distribution-free interval between order statistics;
 * a paired difference (two methods on the same data, common random numbers):
-  the t interval of the mean of the per-run differences;
-* one more run (where a run computed again elsewhere may fall): the t prediction interval, or the
-  runs' range where that is wider.
+  the t interval of the mean of the per-run differences.
 
 The decisions themselves are tests (:mod:`replication.evidence.inference`);
 these intervals are what a reader sees beside them.
@@ -133,19 +131,6 @@ def median(values) -> Estimate:
     if low_rank < 1 or high_rank >= n:  # too few runs for a 95% order-statistic interval
         return Estimate(middle, math.nan, math.nan, n, "order statistics")
     return Estimate(middle, float(values[low_rank - 1]), float(values[high_rank]), n, "order statistics")
-
-
-def prediction(values, level: float) -> Estimate:
-    """Where one more run of the same experiment falls, at ``level``: Student's t prediction interval
-    mean +- t(n - 1) s sqrt(1 + 1/n), or the range of ``values`` where that is wider (skewed runs).  One
-    value, or every value equal: that value alone (no spread to allow another)."""
-    values = _finite(values)
-    if len(values) == 0:
-        return Estimate(math.nan, math.nan, math.nan, 0, "t prediction", level)
-    centre, n = float(values.mean()), len(values)
-    half = float(stats.t.ppf((1 + level) / 2, n - 1) * values.std(ddof=1) * math.sqrt(1 + 1 / n)) if n > 1 else 0.0
-    return Estimate(centre, min(centre - half, float(values.min())), max(centre + half, float(values.max())), n,
-                    "t prediction", level)
 
 
 def estimate(values, quantity: Quantity, statistic: str = "mean") -> Estimate:

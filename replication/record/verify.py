@@ -49,10 +49,11 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
+from scipy import stats
 
 from replication.condition import PREFIX
 from replication.errors import ConfigError, fail
-from replication.evidence.statistics import prediction
+from replication.evidence.statistics import Estimate
 from replication.record.manifest import LIBRARIES, PAGES, RECOMPUTED, Manifest
 from replication.record.runs import (
     CURVES_DIR, FAILURE, LABELS, PARAMETERS, UNIVERSE, Record, read_rows, row_identity, runs_table, write_table,
@@ -71,6 +72,20 @@ LEVEL = 0.99  # a diverged run's columns against its cell's recorded runs: the p
 START = 5.0  # seconds per experiment re-computed, beside its runs' own: loading its scenes and compiled kernels
 DRAW = (10.0, 0.0025)  # seconds to judge an experiment's or multiverse's verdicts: fixed, and per recorded run
 
+
+
+def prediction(values, level: float) -> Estimate:
+    """Where one more run of the same experiment falls, at ``level``: Student's t prediction interval
+    mean +- t(n - 1) s sqrt(1 + 1/n), or the range of ``values`` where that is wider (skewed runs).  One
+    value, or every value equal: that value alone (no spread to allow another)."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    if len(values) == 0:
+        return Estimate(math.nan, math.nan, math.nan, 0, "t prediction", level)
+    centre, n = float(values.mean()), len(values)
+    half = float(stats.t.ppf((1 + level) / 2, n - 1) * values.std(ddof=1) * math.sqrt(1 + 1 / n)) if n > 1 else 0.0
+    return Estimate(centre, min(centre - half, float(values.min())), max(centre + half, float(values.max())), n,
+                    "t prediction", level)
 
 @dataclass(frozen=True)
 class Tolerance:
