@@ -565,8 +565,8 @@ class Best(ClaimTest):
 
     def checks(self, records, tables):
         metric, method = self.spec["metric"], self.spec["method"]
-        found = rankings(_ranked(records, self.spec), self.spec).get(self.spec.get("group", ""))
-        if found is None or method not in found.methods:
+        found = _ranking(records, self.spec)
+        if found is None:
             return []
         i = found.index(method)
         tested = best_test(found.per_sequence_means, i, found.lower_is_better)
@@ -590,15 +590,17 @@ class Best(ClaimTest):
         return checks
 
 
-def _ranked(records: pd.DataFrame, spec: dict) -> pd.DataFrame:
-    """The runs a ranking claim is about: its ``among`` methods (with ``method``) and its ``sequences`` (values
-    of the variable ``over``); every one where unset."""
+def _ranking(records: pd.DataFrame, spec: dict):
+    """The ranking a ``best`` or ``rank`` claim is about (None where its method is not ranked): the runs of its
+    ``among`` methods (with ``method``) over its ``sequences`` (values of the variable ``over``), every one where
+    unset, in the ranking of its ``group``."""
     keep = pd.Series(True, index=records.index)
     if spec.get("among"):
         keep &= records["method"].isin([spec["method"], *spec["among"]])
     if spec.get("sequences"):
         keep &= values_of(records, spec.get("over", "scene")).isin(spec["sequences"])
-    return records[keep]
+    found = rankings(records[keep], spec).get(spec.get("group", ""))
+    return found if found is not None and spec["method"] in found.methods else None
 
 
 class Rank(ClaimTest):
@@ -611,8 +613,8 @@ class Rank(ClaimTest):
 
     def checks(self, records, tables):
         method = self.spec["method"]
-        found = rankings(_ranked(records, self.spec), self.spec).get(self.spec.get("group", ""))
-        if found is None or method not in found.methods:
+        found = _ranking(records, self.spec)
+        if found is None:
             return []
         rank, top = found.rank(found.index(method)), self.spec["top"]
         what = f"{method}'s rank in mean {self.spec['metric']} among {len(found.methods)} over {len(found.sequences)} sequences, at most {top}"
