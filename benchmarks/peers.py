@@ -326,7 +326,8 @@ def figure(times: pd.DataFrame, table: pd.DataFrame, bound: pd.DataFrame, path: 
         ax.set_xlabel("N")
         ax.set_ylabel(f"seconds per {unit} (median of rounds)")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=6)
+        if ax.get_legend_handles_labels()[0]:  # resampling: empty when filterpy was not run
+            ax.legend(fontsize=6)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
