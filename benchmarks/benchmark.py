@@ -340,7 +340,7 @@ def main() -> None:
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
     rounds = likelihood_rounds()
     counted = instructions() if "--instructions" in sys.argv[1:] else pd.DataFrame(
-        [{"side": "not counted in this run (make benchmark counts them: benchmark.py --instructions, about 3 min)",
+        [{"side": "not counted in this run (make benchmark counts them: benchmark.py --instructions: about 11 CPU-minutes, mostly Python under valgrind)",
           "instructions_per_particle": np.nan}])
     bis_speed, bis_profile, bis_scaling = bis_pf_36()
     summary = ratios(rounds, bis_speed, counted)
