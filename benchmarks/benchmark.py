@@ -8,8 +8,9 @@
    for), the vectorised numpy path the kernel replaced, and a per-particle
    loop of the same kernel histogram.
 2. Resampling and a bootstrap PF step on the UNGM, N = 10^2 .. 10^6 (against
-   ``particles``, Stone Soup and filterpy, each in its own venv:
-   ``benchmarks/peers.py``, the second half of ``make benchmark``).
+   ``particles``, Stone Soup and filterpy, each in its own venv, in the
+   library's and the runner's environment: ``benchmarks/peers.py``, the
+   second half of ``make benchmark``).
 3. Rendering a 480 x 410 synthetic frame with 36 targets.
 4. BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second
    against the paper's 5.52, a profile of where the time goes, and its time
@@ -26,10 +27,13 @@
    loop's, counted by ``valgrind --tool=callgrind`` (the same whatever the
    load). The PF step's ratios against its peers are ``peers.py``'s.
 
-BLAS runs one thread, as in the experiments' workers (joblib's loky limits
-each worker to cpu_count // n_jobs threads: one on this two-core machine);
-with its default threads, the weighted means and ESS of a 100,000-particle
-step (numpy dot products) are several times slower on a busy machine.
+Everything here is timed in this process, in the runner's environment: one
+BLAS thread, as in the experiments' workers (joblib's loky limits each worker
+to cpu_count // n_jobs threads: one on this two-core machine), and glibc's
+raised allocator thresholds (``replication/runner/memory.py``).  The PF step
+as a library user calls it, from a plain script with the defaults, is timed
+by ``peers.py`` in both environments (a step calls no BLAS: its sums are
+compiled, ``replication/smc/weights.py``).
 
 Writes ``reports/benchmark/`` (CSV, figures, a page the report index links).
 A script, not a test: timings depend on the machine and its load.
@@ -128,24 +132,36 @@ def instructions(n: int = 1000, calls: int = 3) -> pd.DataFrame:
     """Instructions per particle of each side of the likelihood ratio, counted by ``valgrind --tool=callgrind``
     (the same count run after run, whatever the load): each side in a child process that prepares the
     inputs and calls it ``calls`` times, and again ``2 calls`` times; the difference over ``calls n`` is
-    the count per particle, everything else (Python, imports, the first call's kernel load) cancelling.  A
-    first child compiles numba's kernels for the CPU valgrind presents, which numba then loads from its cache."""
+    the count per particle, everything else (Python, imports, the first call's kernel load) cancelling.
+
+    Numba compiles its kernels for the CPU it finds, and valgrind presents another (fewer features: no
+    AVX-512, ...); compiled under valgrind, the kernels took a fresh clone about 20 minutes.  So the CPU
+    LLVM finds under valgrind is read first (a child that imports llvmlite alone), the kernels are
+    compiled for it natively (``NUMBA_CPU_NAME`` and ``NUMBA_CPU_FEATURES``: numba's cache is keyed by
+    them) and the counted children load them from numba's cache."""
     valgrind = shutil.which("valgrind")
     if valgrind is None:
         return pd.DataFrame([{"side": "valgrind not found: no instruction counts", "instructions_per_particle": np.nan}])
+    probe = subprocess.run([valgrind, "--tool=none", "-q", sys.executable, "-c",
+                            "import llvmlite.binding as ll; print(ll.get_host_cpu_name()); "
+                            "print(ll.get_host_cpu_features().flatten())"],
+                           capture_output=True, text=True, check=True)
+    name, features = probe.stdout.split()[-2:]
+    env = {**os.environ, "PYTHONHASHSEED": "0", "NUMBA_CPU_NAME": name, "NUMBA_CPU_FEATURES": features}
+    subprocess.run([sys.executable, str(SIDES), OURS, str(n), "0"], check=True, env=env)  # compiled natively
+
     def counted(side: str, times: int) -> int:
         done = subprocess.run([valgrind, "--tool=callgrind", "--callgrind-out-file=/dev/null", sys.executable,
-                               str(SIDES), side, str(n), str(times)],
-                              capture_output=True, text=True, check=True, env={**os.environ, "PYTHONHASHSEED": "0"})
+                               str(SIDES), side, str(n), str(times)], capture_output=True, text=True, check=True, env=env)
         return int(re.search(r"Collected : (\d+)", done.stderr).group(1))
 
-    counted(OURS, 0)  # numba compiles its kernels for valgrind's CPU once and caches them: not in either count
     rows = []
     for side in (OURS, CALCHIST):
         few, more = counted(side, calls), counted(side, 2 * calls)
         rows.append({"side": side, "N": n, "instructions_per_particle": (more - few) / (calls * n)})
     table = pd.DataFrame(rows)
     table.attrs["ratio"] = table["instructions_per_particle"].iloc[1] / table["instructions_per_particle"].iloc[0]
+    table.attrs["cpu"] = name
     return table
 
 
@@ -324,7 +340,7 @@ def main() -> None:
     likelihood, core, render_cost = likelihood_throughput(), smc_core(), rendering()
     rounds = likelihood_rounds()
     counted = instructions() if "--instructions" in sys.argv[1:] else pd.DataFrame(
-        [{"side": "not counted in this run (make benchmark counts them: benchmark.py --instructions, about 3 min)",
+        [{"side": "not counted in this run (make benchmark counts them: benchmark.py --instructions: about 11 CPU-minutes, mostly Python under valgrind)",
           "instructions_per_particle": np.nan}])
     bis_speed, bis_profile, bis_scaling = bis_pf_36()
     summary = ratios(rounds, bis_speed, counted)
@@ -351,8 +367,9 @@ def main() -> None:
             up="../index.html",
             up_label="all experiments",
             meta=f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-            f"numpy {np.__version__}, OpenCV {cv2.__version__}. Best of several calls, single process, one BLAS "
-            "thread (as the experiments' workers). Made by make benchmark.",
+            f"numpy {np.__version__}, OpenCV {cv2.__version__}. Best of several calls, single process, in the runner's "
+            "environment (one BLAS thread and glibc's raised allocator thresholds, as the experiments' workers; the "
+            "PF step from a plain script with the defaults: the peers' page). Made by make benchmark.",
             sections=[
                 {"title": f"Issue 34's ratios: each measured {ROUNDS} times in this run (median and range; the "
                           "likelihood timed in turn with its peer, A B A B), and the likelihood's instructions per "
@@ -372,7 +389,7 @@ def main() -> None:
                  "figure": "throughput.png", "table": ""},
                 {"title": "Colour likelihood throughput (480x410 frame, 40x40 boxes, 8x8x4 bins)",
                  "figure": "likelihood.png", "table": html_table(likelihood.round(5))},
-                {"title": "SMC core", "figure": "smc_core.png", "table": html_table(core.round(2))},
+                {"title": "SMC core, in the runner's environment (from a plain script: the peers' page)", "figure": "smc_core.png", "table": html_table(core.round(2))},
                 {"title": "Scene rendering", "figure": None, "table": html_table(render_cost.round(3))},
                 {"title": "BIS-PF on 36 balls (N = 400, K = 4000), one process: frames per second",
                  "figure": None, "table": html_table(bis_speed.round(2))},

@@ -124,3 +124,23 @@ def test_package_source_never_calls_legacy_global_random():
         for line in path.read_text().splitlines():
             if "np.random." in line:
                 assert any(a in line for a in allowed) and "np.random.seed" not in line, f"{path}: {line}"
+
+
+def test_buffers_kept_across_steps_never_overwrite_what_a_step_handed_out():
+    """The loop reuses its log-weight and weight arrays from step to step; the log-weights and particles
+    a step leaves in the state stay as they were after later steps (a step without resampling hands on
+    log W = lw - logsumexp(lw), a new array; one with resampling the equal log-weights, never written)."""
+    model = UNGM(steps=30)
+    observations = model.simulate(np.random.default_rng(0))[1]
+    pf = bootstrap(500, "systematic", 0.5)
+    state = pf.start(model, np.random.default_rng(1))
+    kept = []
+    for z in observations:
+        pf.step(state, z)
+        kept.append((state.particles, state.log_weights, state.particles.copy(), state.log_weights.copy()))
+    for particles, log_weights, particles_then, log_weights_then in kept:
+        np.testing.assert_array_equal(particles, particles_then)
+        np.testing.assert_array_equal(log_weights, log_weights_then)
+    again = pf.run(model, observations, np.random.default_rng(1))
+    np.testing.assert_array_equal(state.output().means, again.means)
+    assert 0 < again.resample_count < len(observations)

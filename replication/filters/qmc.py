@@ -17,15 +17,17 @@ is then deterministic whenever the loop does not resample (``ess_threshold=0``;
 TR-SQMC resamples with its own points).
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import ndtri
 
+from replication.libm import exp, log
 from replication.qmc import POINT_SETS, point_set, random_shift
 from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy
 from replication.smc.resampling import inverse_cdf
-from replication.smc.weights import logsumexp
+from replication.smc.weights import logsumexp, moments
 
 NQMCPF_PROPOSALS = ("prior", "support_box")
 
@@ -41,7 +43,7 @@ def _gaussian_log_density(x: np.ndarray, mean, cov) -> np.ndarray:
     """log N(x; mean, cov) per particle, x of shape (N,) or (N, d) (cov scalar, per-coordinate or full)."""
     residual = x - mean
     if residual.ndim == 1:
-        return -0.5 * (residual**2 / cov + np.log(2.0 * np.pi * cov))
+        return -0.5 * (residual**2 / cov + log(2.0 * np.pi * cov))
     cov = np.asarray(cov, dtype=float)
     full = cov if cov.ndim == 2 else np.diag(np.broadcast_to(cov, residual.shape[1:]))
     solved = np.linalg.solve(full, residual.T).T
@@ -83,7 +85,7 @@ class _PointSource:
     def initial(self, model, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """Step 1: x_0^i = x0 + chol(P0) Phi^-1(u_i), equally weighted."""
         u = self.uniforms(n, np.shape(model.x0), rng)
-        return _gaussian(model.x0, model.P0, u), np.full(n, -np.log(n))
+        return _gaussian(model.x0, model.P0, u), np.full(n, -math.log(n))
 
 
 @dataclass(frozen=True)
@@ -141,7 +143,7 @@ class SupportBoxProposal(_PointSource):
         """Eq (6) on mean ± c sqrt(variances); log-weights log_target(x) - log q(x) - log N."""
         half = self.width * np.sqrt(variances)
         x = (mean - half) + 2.0 * half * self.uniforms(n, np.shape(variances), rng)
-        return x, log_target(x) + np.sum(np.log(2.0 * half)) - np.log(n)
+        return x, log_target(x) + np.sum(log(2.0 * half)) - math.log(n)
 
     def initial(self, model, n, rng):
         """Step 1: the good points on x0 ± c sqrt(P0), weighted by p(x_0) / q(x_0)."""
@@ -152,10 +154,9 @@ class SupportBoxProposal(_PointSource):
 
     def __call__(self, model, particles, log_weights, t, rng):
         log_w = log_weights - logsumexp(log_weights)
-        w = np.exp(log_w)
         means = model.f(particles, t)
-        mean = w @ means
-        variances = w @ (means - mean) ** 2 + _variances(model.Q, particles.shape[1:])
+        mean, spread, _ = moments(means, exp(log_w))  # numpy's pairwise sums: alike on every CPU
+        variances = spread + _variances(model.Q, particles.shape[1:])
 
         def log_predictive(x):  # eq (7)
             return logsumexp(log_w + model.transition_log_density(x[:, None], particles[None, :], t), axis=1)
@@ -183,8 +184,8 @@ class SQMCProposal(_PointSource):
         u = self.draw(n, 2, rng)
         u = u[np.argsort(u[:, 0])]
         order = np.argsort(particles)
-        ancestors = order[inverse_cdf(np.exp(log_weights[order] - log_weights.max()), u[:, 0])]
-        return _gaussian(model.f(particles[ancestors], t), model.Q, u[:, 1]), np.full(n, -np.log(n))
+        ancestors = order[inverse_cdf(exp(log_weights[order] - log_weights.max()), u[:, 0])]
+        return _gaussian(model.f(particles[ancestors], t), model.Q, u[:, 1]), np.full(n, -math.log(n))
 
 
 @dataclass

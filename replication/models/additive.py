@@ -1,12 +1,13 @@
 """Scalar models with additive Gaussian noise: x_t = f(x_{t-1}, t) + w_t, z_t = h(x_t) + v_t."""
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from replication.compiled import elementwise
 
-LOG_2PI = float(np.log(2.0 * np.pi))
+LOG_2PI = math.log(2.0 * math.pi)
 
 
 @elementwise("float64(float64, float64, float64, float64)")
@@ -55,15 +56,16 @@ class AdditiveGaussianModel:
         return self.x0 + np.sqrt(self.P0) * rng.standard_normal(n)
 
     def propagate(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray:
-        return _shifted(self.f(particles, t), np.sqrt(self.Q), rng.standard_normal(particles.shape))
+        noise = rng.standard_normal(particles.shape)
+        return _shifted(self.f(particles, t), math.sqrt(self.Q), noise, out=noise)  # one array fewer
 
     def log_likelihood(self, particles: np.ndarray, observation: float, t: int) -> np.ndarray:
         """log N(z_t; h(x), R)."""
-        return log_normal_density(observation, self.h(particles), self.R, np.log(self.R))
+        return log_normal_density(observation, self.h(particles), self.R, math.log(self.R))
 
     def transition_log_density(self, x_new: np.ndarray, x_old: np.ndarray, t: int) -> np.ndarray:
         """log N(x_new; f(x_old, t), Q), broadcasting x_new against x_old."""
-        return log_normal_density(x_new, self.f(x_old, t), self.Q, np.log(self.Q))
+        return log_normal_density(x_new, self.f(x_old, t), self.Q, math.log(self.Q))
 
     def simulate(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """A trajectory x_1..x_T and its observations z_1..z_T."""

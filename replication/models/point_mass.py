@@ -12,11 +12,20 @@ UNGM never falls much below 0.5) the mean is exact to many digits; tests check
 it against the Kalman filter and against a grid of half the spacing.  Masses
 below ``prune * max q`` are dropped from the prediction sum (at most
 ``M * prune`` of the mass), which is what keeps the cost near O(M * support).
+Every sum is numpy's pairwise sum and every exp and log the C library's, so the grid's means are the
+same numbers on every CPU (:mod:`replication.smc.weights`); the prediction sum is compiled, each row's
+exponentials summed as they are made.
 """
 
-import numpy as np
+import math
 
+import numpy as np
+from numba import njit
+
+from replication.libm import exp, log
 from replication.models.additive import AdditiveGaussianModel
+from replication.smc.pairwise import BLOCK, block_sum, half
+from replication.smc.weights import moments
 
 
 def point_mass_filter(
@@ -32,7 +41,7 @@ def point_mass_filter(
     grid = np.linspace(-half_width, half_width, n_points)
     if model.P0 > 0:
         support = grid
-        masses = np.exp(-0.5 * (grid - model.x0) ** 2 / model.P0)
+        masses = exp(-0.5 * (grid - model.x0) ** 2 / model.P0)
         masses /= masses.sum()
     else:
         support, masses = np.array([model.x0]), np.array([1.0])
@@ -40,12 +49,31 @@ def point_mass_filter(
     for k, z in enumerate(observations):
         t = k + 1
         keep = masses > prune * masses.max()
-        predictive = np.exp(model.transition_log_density(grid[:, None], support[keep][None, :], t)) @ masses[keep]
-        with np.errstate(divide="ignore"):
-            log_post = np.log(predictive) + model.log_likelihood(grid, z, t)
-        masses = np.exp(log_post - log_post.max())
+        log_transition = model.transition_log_density(grid[:, None], support[keep][None, :], t)
+        predictive = _predictive(np.ascontiguousarray(log_transition, dtype=float), masses[keep], np.empty(n_points))
+        log_post = log(predictive) + model.log_likelihood(grid, z, t)
+        masses = exp(log_post - log_post.max())
         masses /= masses.sum()
         support = grid
-        means[k] = masses @ grid
-        variances[k] = masses @ (grid - means[k]) ** 2
+        means[k], variances[k], _ = moments(grid, masses)
     return means, variances
+
+
+@njit(cache=True, error_model="numpy")
+def _predictive(log_transition, masses, out):
+    """out_i = sum_j exp(log N(x_i; f(x_j), Q)) q_j for each grid point i, ``np.sum``'s order of the row."""
+    scratch = np.empty(BLOCK)
+    for i in range(log_transition.shape[0]):
+        out[i] = 0.0 + _row_tree(log_transition[i], masses, scratch)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _row_tree(log_density, masses, scratch):
+    n = log_density.size
+    if n > BLOCK:
+        h = half(n)
+        return _row_tree(log_density[:h], masses[:h], scratch) + _row_tree(log_density[h:], masses[h:], scratch)
+    for j in range(n):
+        scratch[j] = math.exp(log_density[j]) * masses[j]
+    return block_sum(scratch[:n])

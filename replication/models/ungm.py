@@ -2,9 +2,8 @@
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from replication.compiled import elementwise
+from replication.libm import cos
 from replication.models.additive import AdditiveGaussianModel
 
 
@@ -30,7 +29,7 @@ class UNGM(AdditiveGaussianModel):
     """
 
     def f(self, x, t):
-        return _growth(x, 8.0 * np.cos(1.2 * (t - 1)))
+        return _growth(x, 8.0 * cos(1.2 * (t - 1)))
 
     def h(self, x):
         return _square_over_20(x)

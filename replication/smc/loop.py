@@ -12,6 +12,7 @@ The bootstrap filter of Gordon, Salmond and Smith (1993) is the loop with
 neither.
 """
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -20,13 +21,8 @@ import numpy as np
 
 from replication.errors import RunFailed
 from replication.smc.resampling import RESAMPLERS
-from replication.smc.weights import (
-    DegenerateWeightsError,
-    ess,
-    normalise,
-    weighted_mean,
-    weighted_variance,
-)
+from replication.libm import log
+from replication.smc.weights import DegenerateWeightsError, moments, normalise
 
 LogLikelihood = Callable[[np.ndarray], np.ndarray]
 
@@ -129,10 +125,10 @@ class Summaries:
     degenerate: list = field(default_factory=list)
 
     def add(self, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
-        mean = weighted_mean(particles, weights)
+        mean, variance, ess = moments(particles, weights)
         self.means.append(mean)
-        self.variances.append(weighted_variance(particles, weights, mean))
-        self.ess.append(ess(weights))
+        self.variances.append(variance)
+        self.ess.append(ess)
         self.degenerate.append(degenerate)
 
     def output(self, log_evidence: float) -> FilterOutput:
@@ -147,6 +143,30 @@ class Summaries:
 
 
 @dataclass
+class Buffers:
+    """The arrays of N numbers a filter's steps write and read back within the step (its log-weights, its
+    weights, and the equal log-weights after resampling), kept from step to step: a new array of a large N
+    costs its page faults again at every step unless the C library's allocator keeps freed memory (the
+    runner raises its thresholds, a plain script does not)."""
+
+    arrays: dict = field(default_factory=dict)
+
+    def get(self, name: str, shape: tuple) -> np.ndarray:
+        """The array ``name`` of ``shape``, written by its caller before it is read."""
+        array = self.arrays.get(name)
+        if array is None or array.shape != shape:
+            array = self.arrays[name] = np.empty(shape)
+        return array
+
+    def uniform(self, n: int) -> np.ndarray:
+        """log W_i = -log N for N particles (the same array while N stays: a step never writes into it)."""
+        array = self.arrays.get("uniform")
+        if array is None or array.size != n:
+            array = self.arrays["uniform"] = np.full(n, -math.log(n))
+        return array
+
+
+@dataclass
 class FilterState:
     """A filter between steps: its particles, log-weights, random stream and what it has recorded."""
 
@@ -157,6 +177,7 @@ class FilterState:
     t: int = 0
     log_evidence: float = 0.0
     records: Summaries = field(default_factory=Summaries)
+    buffers: Buffers = field(default_factory=Buffers, repr=False)
 
     def output(self) -> FilterOutput:
         return self.records.output(self.log_evidence)
@@ -189,8 +210,8 @@ class ParticleFilter:
 
     def start(self, model: StateSpaceModel, rng: np.random.Generator) -> FilterState:
         """Particles from the prior at t = 0, equally weighted; filters can then be stepped in lockstep."""
-        n = self.n_particles
-        return FilterState(model, rng, model.sample_initial(n, rng), np.full(n, -np.log(n)))
+        n, buffers = self.n_particles, Buffers()
+        return FilterState(model, rng, model.sample_initial(n, rng), buffers.uniform(n), buffers=buffers)
 
     def step(self, state: FilterState, z) -> None:
         """Propose, move, weight, estimate and maybe resample for the next observation z_t."""
@@ -211,14 +232,15 @@ class ParticleFilter:
         if self.move is not None:
             particles, correction = self.move(particles, lambda x: model.log_likelihood(x, z, t), rng)
             log_weights = log_weights + correction
-        predicted = log_weights
-        log_weights = log_weights + model.log_likelihood(particles, z, t)
+        predicted, likelihood = log_weights, model.log_likelihood(particles, z, t)
+        shape = np.broadcast_shapes(np.shape(log_weights), np.shape(likelihood))
+        log_weights = np.add(log_weights, likelihood, out=state.buffers.get("log_weights", shape))
         try:
-            weights, log_total = normalise(log_weights)
+            weights, log_total = normalise(log_weights, state.buffers.get("weights", shape))
             degenerate = False
         except DegenerateWeightsError:
             log_weights = predicted
-            weights, log_total = normalise(predicted)
+            weights, log_total = normalise(predicted, state.buffers.get("weights", np.shape(predicted)))
             degenerate = True
         state.log_evidence += log_total
         return Weighed(particles, weights, log_weights, log_total, degenerate)
@@ -230,7 +252,7 @@ class ParticleFilter:
         do_resample = self.resampling.wants(state.records.ess[-1], n)
         if do_resample:
             particles = particles[RESAMPLERS[self.resampling.scheme](weighed.weights, state.rng)]
-            log_weights = np.full(n, -np.log(n))
+            log_weights = state.buffers.uniform(n)
         else:
             log_weights = weighed.log_weights
         state.records.resampled.append(do_resample)
@@ -257,4 +279,4 @@ class Weighed:
     def reweighted(self, weights: np.ndarray) -> "Weighed":
         """The same particles under other normalised weights (a multi-target interaction's)."""
         with np.errstate(divide="ignore"):
-            return Weighed(self.particles, weights, np.log(weights), 0.0, self.degenerate)
+            return Weighed(self.particles, weights, log(weights), 0.0, self.degenerate)
