@@ -25,7 +25,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-BUDGET_BYTES = 3 * 2**29  # 1.5 GiB of frames (their bin images add two thirds): PETS09-S2L1's 795 are 1.05 GB
+BUDGET_BYTES = 3 * 2**29  # 1.5 GiB of frames (bin images add two thirds, grey levels a third): PETS09-S2L1's 795 are 1.05 GB
 _kept: dict = {}  # (sequence, key) -> its frame, every key of one sequence
 _lock = threading.Lock()  # the threading backend's workers share a process, and so this store
 

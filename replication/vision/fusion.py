@@ -38,9 +38,8 @@ def fusion_coefficients(rho: float, s: float) -> tuple[float, float]:
 
 
 def grey(frame: np.ndarray) -> np.ndarray:
-    """The frame's grey levels as float32 (what :func:`~replication.vision.ssim.patches` reads), once per kept
-    frame (:mod:`replication.vision.derived`)."""
-    return derived(frame, "grey", lambda: cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY).astype(np.float32))
+    """The frame's grey levels (uint8), once per kept frame (:mod:`replication.vision.derived`)."""
+    return derived(frame, "grey", lambda: cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY))
 
 
 @dataclass

@@ -30,7 +30,7 @@ def patches(grey: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> tuple
     map_y = boxes[:, 1, None, None] + v[None, :, None] * boxes[:, 3, None, None] - 0.5
     map_x = np.broadcast_to(map_x, (n, th, tw)).reshape(n * th, tw)
     map_y = np.broadcast_to(map_y, (n, th, tw)).reshape(n * th, tw)
-    sampled = cv2.remap(grey.astype(np.float32, copy=False), map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+    sampled = cv2.remap(grey.astype(np.float32), map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
     height, width = grey.shape
     inside = (map_x >= -0.5) & (map_x <= width - 0.5) & (map_y >= -0.5) & (map_y <= height - 0.5)
     return sampled.reshape(n, th, tw), inside.reshape(n, -1).mean(axis=1)
