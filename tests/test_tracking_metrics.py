@@ -1,10 +1,13 @@
 """Tracking metrics on hand-computed cases, and CLEAR MOT / IDF1 against py-motmetrics."""
 
+import math
+
 import numpy as np
 import pytest
 
 from replication.metrics import multi
 from replication.metrics import tracking as tm
+from replication.metrics.means import fsum_mean
 
 
 def test_centre_error_iou_and_deviation_hand_computed():
@@ -89,3 +92,34 @@ def test_clear_mot_and_idf1_agree_with_motmetrics(seed):
     assert ours["switches"] == theirs["num_switches"]
     assert ours["fragmentations"] == theirs["num_fragmentations"]
     assert multi.idf1(truth, est, 8.0, truth_present, est_present) == pytest.approx(theirs["idf1"])
+
+
+def test_a_score_is_the_mean_of_its_exact_sum_rounded_once_in_whatever_order():
+    """A hand case where a left-to-right sum (0: each 1 is lost against 1e16), numpy's pairwise sum (14: eight
+    accumulators, one of them holding 1e16) and the exact sum (15) all differ: the scores' mean is the
+    exact sum over the count, math.fsum's, for the values in any order or layout."""
+    values = np.array([1e16] + [1.0] * 15 + [-1e16])
+    left_to_right = 0.0
+    for value in values:
+        left_to_right += value
+    assert (left_to_right, float(np.sum(values)), math.fsum(values)) == (0.0, 14.0, 15.0)
+    assert fsum_mean(values) == math.fsum(values) / 17 == 15 / 17
+    assert fsum_mean(values[::-1]) == fsum_mean(values.reshape(17, 1).T) == fsum_mean(values.tolist()) == 15 / 17
+    assert math.isnan(fsum_mean([])) and math.isnan(fsum_mean([1.0, math.nan]))
+    with np.errstate(over="ignore", invalid="ignore"):  # numpy's answers where no float holds the exact sum
+        assert fsum_mean([math.inf, 1.0]) == math.inf and fsum_mean([1e308, 1e308]) == math.inf
+        assert math.isnan(fsum_mean([math.inf, -math.inf]))
+
+
+def test_the_multi_target_errors_are_their_distances_exact_means():
+    """mean_error_per_target, identity_free_error, OSPA (p = 1) and the error while tracked are the fsum means
+    of their distances: the hand case's 1e16 would lose the unit distances in a running sum."""
+    truth = np.zeros((4, 2, 2))
+    estimates = truth.copy()
+    estimates[:, 0, 0] = [1e16, 1.0, 1.0, -0.0]  # target 0's distances: 1e16, 1, 1, 0
+    estimates[:, 1, 1] = 1.0  # target 1 off by 1 px in every frame
+    distances = np.linalg.norm(estimates - truth, axis=-1)
+    assert multi.mean_error_per_target(estimates, truth) == math.fsum(distances.ravel()) / 8 == (1e16 + 6) / 8
+    onsets = np.array([1, 4])  # target 0 lost from frame 1: its first frame, and target 1's four
+    assert multi.tracked_error(estimates, truth, onsets) == (1e16 + 4) / 5
+    assert multi.ospa(estimates, truth, cutoff=20.0) == (10.5 + 1 + 1 + 0.5) / 4

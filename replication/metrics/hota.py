@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 from trackeval.metrics import HOTA
 
+from replication.metrics.means import fsum_mean
 from replication.metrics.mot import NO_ROWS, by_frame, drop_ignored, iou_matrix
 
 SCORES = {  # our key: TrackEval's field, averaged over alpha
@@ -92,7 +93,7 @@ def hota(
     data = hota_data(truth, hypotheses, ignored, min_iou)
     res = HOTA().eval_sequence(data)
     return {
-        **{key: float(np.mean(res[field])) for key, field in SCORES.items()},
+        **{key: fsum_mean(res[field]) for key, field in SCORES.items()},
         "hota_0": float(res["HOTA(0)"]),
         "loca_0": float(res["LocA(0)"]),
     }

@@ -27,6 +27,7 @@ import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
 from replication.metrics import multi
+from replication.metrics.means import fsum_mean
 from replication.metrics.tracking import centre_error, iou
 
 BOX = ["x", "y", "w", "h"]
@@ -141,7 +142,7 @@ def matched_centre_error(truth: pd.DataFrame, hypotheses: pd.DataFrame, matches:
     keys = ["frame", "id"]
     true = matches.merge(truth, left_on=["frame", "truth_id"], right_on=keys, how="left")
     found = matches.merge(hypotheses, left_on=["frame", "hypothesis_id"], right_on=keys, how="left")
-    return float(centre_error(found[BOX].to_numpy(), true[BOX].to_numpy()).mean())
+    return fsum_mean(centre_error(found[BOX].to_numpy(), true[BOX].to_numpy()))
 
 
 def detection_overlap(hypotheses: pd.DataFrame, detections: pd.DataFrame) -> float:
@@ -153,4 +154,4 @@ def detection_overlap(hypotheses: pd.DataFrame, detections: pd.DataFrame) -> flo
     found = by_frame(detections)
     best = [iou_matrix(rows.boxes, found[frame].boxes).max(axis=1) if frame in found
             else np.zeros(len(rows.boxes)) for frame, rows in by_frame(hypotheses).items()]
-    return float(np.concatenate(best).mean())
+    return fsum_mean(np.concatenate(best))

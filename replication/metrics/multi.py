@@ -19,26 +19,28 @@ they match (IDTP); IDF1 = 2 IDTP / (truth detections + hypothesis detections).
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from replication.metrics.means import fsum_mean
+
 UNMATCHABLE = 1e9
 
 
 def mean_error_per_target(estimates: np.ndarray, truth: np.ndarray) -> float:
     """bis_pf's error: mean over frames and targets of |estimate_m - truth_m| (px), estimate m for target m."""
-    return float(np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1).mean())
+    return fsum_mean(np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1))
 
 
 def identity_free_error(estimates: np.ndarray, truth: np.ndarray) -> float:
     """The error with identities left out: in each frame, the estimates assigned to the truths by minimum
     total distance (Hungarian, :func:`scipy.optimize.linear_sum_assignment`), the mean matched distance
     over frames and targets.  Two estimates that swap balls keep a small error here."""
-    return float(assignments(estimates, truth)[1].mean())
+    return fsum_mean(assignments(estimates, truth)[1])
 
 
 def ospa(estimates: np.ndarray, truth: np.ndarray, cutoff: float, order: int = 1) -> float:
     """Mean over frames of the OSPA distance (Schuhmacher, Vo and Vo 2008) between equally many estimates
     and truths: (min over assignments of the mean of min(d, ``cutoff``)^p)^(1/p)."""
     d = np.minimum(_pairwise(estimates, truth), cutoff) ** order
-    return float(np.mean([d[k][linear_sum_assignment(d[k])].mean() ** (1 / order) for k in range(len(d))]))
+    return fsum_mean([fsum_mean(d[k][linear_sum_assignment(d[k])]) ** (1 / order) for k in range(len(d))])
 
 
 def _pairwise(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
@@ -106,7 +108,7 @@ def tracked_error(estimates: np.ndarray, truth: np.ndarray, onsets: np.ndarray) 
     (``onsets``: :func:`loss_onsets`); NaN when every target is lost at once."""
     errors = np.linalg.norm(np.asarray(estimates) - np.asarray(truth), axis=-1)
     before = np.arange(len(errors))[:, None] < np.asarray(onsets)[None, :]
-    return float(errors[before].mean()) if before.any() else float("nan")
+    return fsum_mean(errors[before])
 
 
 def _distances(truth_k, estimates_k, threshold):

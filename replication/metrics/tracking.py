@@ -20,6 +20,8 @@ GOT-10k's own evaluation (``ExperimentGOT10k.report``) leaves it out.
 
 import numpy as np
 
+from replication.metrics.means import fsum_mean
+
 PRECISION_THRESHOLDS = np.arange(0, 51)
 SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
 # The OTB scores count the first frame, whose box is the given truth, as OTB's toolkit does (hspf
@@ -82,7 +84,7 @@ def success_curve(overlaps: np.ndarray, thresholds: np.ndarray = SUCCESS_THRESHO
 
 def success_auc(overlaps: np.ndarray) -> float:
     """OTB success score: the mean of the 21-point success curve."""
-    return float(success_curve(overlaps).mean())
+    return fsum_mean(success_curve(overlaps))
 
 
 # "Correct tracking" is undefined in ism_pf and fusion_pf: each rule is a per-frame test.

@@ -30,6 +30,7 @@ def write_sequence(sequence: Sequence, out: Path, video: bool = True, fps: float
     for k in range(sequence.n_frames):
         image = sequence.frame(k)
         if boxes:
+            image = image.copy()  # a sequence's frames are read-only: the next reader sees them unmarked
             for x, y, w, h in sequence.truth[k]:
                 cv2.rectangle(image, (int(x), int(y)), (int(x + w - 1), int(y + h - 1)), (0, 255, 0), 1)
         if writer is not None:

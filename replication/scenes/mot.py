@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from replication.paths import resolve
-from replication.scenes.decoded import decoded
+from replication.scenes.kept import decoded
 from replication.scenes.factory import SequenceMissing
 
 SHIPPED_MOT_ROOT = "../shared/data/mot"  # where the project's own MOTChallenge sequences are, beside it
@@ -50,7 +50,7 @@ class MotSequence:
 
     def image(self, frame: int) -> np.ndarray:
         """Frame number ``frame`` (1..n_frames, MOT's numbering) as read-only uint8 BGR, decoded once per
-        process (:mod:`replication.scenes.decoded`)."""
+        process (:mod:`replication.scenes.kept`)."""
         if not 1 <= frame <= self.n_frames:
             raise IndexError(f"{self.name}: frame {frame} outside 1..{self.n_frames}")
         return decoded(self.image_dir / f"{frame:06d}{self.image_ext}")

@@ -17,7 +17,7 @@ import yaml
 from PIL import Image, UnidentifiedImageError
 
 from replication.paths import resolve
-from replication.scenes.decoded import decoded
+from replication.scenes.kept import decoded
 
 SHIPPED_OTB_ROOT = "../shared/data/otb"  # where the project's own OTB sequences are, beside it
 OTB_ROOT = os.environ.get("REPLICATION_OTB") or SHIPPED_OTB_ROOT  # data.otb in conf/config.yaml
@@ -73,7 +73,7 @@ class OTBSequence:
         self.size = frame_size(self._frames)
 
     def frame(self, k: int) -> np.ndarray:
-        """Frame k as read-only uint8 BGR, decoded once per process (:mod:`replication.scenes.decoded`)."""
+        """Frame k as read-only uint8 BGR, decoded once per process (:mod:`replication.scenes.kept`)."""
         return decoded(self._frames[k])
 
 

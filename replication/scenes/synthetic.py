@@ -58,6 +58,8 @@ import cv2
 import numpy as np
 from numba import njit
 
+from replication.scenes.kept import kept
+
 SHAPES = ("ellipse", "box", "ball", "head")
 BACKGROUNDS = ("flat", "gradient", "noise", "clutter")
 MOTIONS = ("scripted", "velocity", "random_walk")
@@ -378,7 +380,12 @@ class SyntheticScene:
         return np.clip(image, 0, 255).astype(np.float32)
 
     def frame(self, k: int) -> np.ndarray:
-        """Frame k as uint8 BGR: background, objects far to near, illumination, camera noise."""
+        """Frame k as read-only uint8 BGR, rendered once per process (:mod:`replication.scenes.kept`): every
+        run on this scene, every method of a repetition whose video is drawn per run, reads the same array."""
+        return kept(self, k, lambda: self.render(k))
+
+    def render(self, k: int) -> np.ndarray:
+        """Frame k drawn anew as uint8 BGR: background, objects far to near, illumination, camera noise."""
         if not 0 <= k < self.n_frames:
             raise IndexError(f"frame {k} outside 0..{self.n_frames - 1}")
         image = self._canvas
@@ -395,7 +402,7 @@ class SyntheticScene:
 
     @cached_property
     def _canvas(self) -> np.ndarray:
-        """The float frame :meth:`frame` composes in, one per scene (a process runs one run at a time: every
+        """The float frame :meth:`render` composes in, one per scene (a process runs one run at a time: every
         backend starts one thread per worker): a new 2 MB array per frame costs more in page faults than the
         drawing (the allocator can hand such arrays back to the system each time)."""
         return np.empty_like(self.background)

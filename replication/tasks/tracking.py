@@ -22,6 +22,7 @@ from replication.filters.tracker import Adaptation, Marginal
 from replication.filters.tracker import tracker as make_tracker
 from replication.metrics import multi
 from replication.metrics import tracking as tm
+from replication.metrics.means import fsum_mean
 from replication.metrics.mot import BOX
 from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
@@ -152,7 +153,7 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
         **{f"error_without_failure[{name}]": float("nan") if value else error for name, value in failed.items()},
         "switches": mot["switches"],
         "mota": mot["mota"],
-        "visible_error": float(errors[visible].mean()) if visible.any() else float("nan"),
+        "visible_error": fsum_mean(errors[visible]),
         **key,
     }
 
@@ -190,16 +191,16 @@ def run(run: Run) -> dict:
     filtered = slice(1, None)  # frame 0 is given
     record = {
         "frames": sequence.n_frames,
-        "mean_cle": float(errors[filtered].mean()),
-        "precision20": float(np.mean([tm.precision_at(e) for e in tm.scored_frames(errors).T])),
-        "success_auc": float(np.mean([tm.success_auc(o) for o in tm.scored_frames(overlaps).T])),
+        "mean_cle": fsum_mean(errors[filtered]),
+        "precision20": fsum_mean([tm.precision_at(e) for e in tm.scored_frames(errors).T]),
+        "success_auc": fsum_mean([tm.success_auc(o) for o in tm.scored_frames(overlaps).T]),
         "ms_per_frame": 1000.0 * seconds / (sequence.n_frames - 1),
         "filter_s": seconds,  # the whole sequence, frame production excluded
         "fps": (sequence.n_frames - 1) / seconds,
         **work.record(sequence.n_frames - 1),  # per filtered frame, all targets
-        "mean_ess": float(np.mean([d["mean_ess"] for d in diagnostics])),
-        "resample_count": float(np.mean([d["resample_count"] for d in diagnostics])),
-        "resample_rate": float(np.mean([d["resample_rate"] for d in diagnostics])),  # % of filtered frames
+        "mean_ess": fsum_mean([d["mean_ess"] for d in diagnostics]),
+        "resample_count": fsum_mean([d["resample_count"] for d in diagnostics]),
+        "resample_rate": fsum_mean([d["resample_rate"] for d in diagnostics]),  # % of filtered frames
         "degenerate_steps": int(sum(d["degenerate_steps"] for d in diagnostics)),
         "outside_frames": outside_frames(estimates[filtered], sequence.size),
     }

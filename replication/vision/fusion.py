@@ -23,6 +23,7 @@ import cv2
 import numpy as np
 
 from replication.vision.colour import ColourLikelihood
+from replication.vision.derived import derived
 from replication.vision.histogram import ColourHistogram
 from replication.vision.likelihood import gaussian_similarity_log_likelihood
 from replication.vision.ssim import patches, structural_similarity
@@ -37,7 +38,8 @@ def fusion_coefficients(rho: float, s: float) -> tuple[float, float]:
 
 
 def grey(frame: np.ndarray) -> np.ndarray:
-    return cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    """The frame's grey levels (uint8), once per kept frame (:mod:`replication.vision.derived`)."""
+    return derived(frame, "grey", lambda: cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY))
 
 
 @dataclass

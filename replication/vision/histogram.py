@@ -39,6 +39,8 @@ import cv2
 import numpy as np
 from numba import njit, uint64
 
+from replication.vision.derived import derived
+
 KERNELS = ("epanechnikov", "diagonal", "uniform")
 GROUP = 8  # boxes the compiled kernel reads side by side (see _bhattacharyya_kernel; its fast path spells out 8)
 BLOCK_SAMPLES = 100_000  # sample points per bincount: big enough to amortise the calls, small enough for cache
@@ -56,23 +58,12 @@ def _contributions(bins: tuple[int, int, int]) -> np.ndarray:
 def hsv_bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
     """(H, W) uint16 image of joint HSV bin indices ``(h * Bs + s) * Bv + v`` of a BGR frame.
 
-    A read-only frame (one a sequence keeps for its next run: :class:`replication.scenes.mot.MotSequence`)
-    gets its bin image computed once per ``bins`` and kept while the frame lives (read-only too)."""
+    A read-only frame (one a sequence keeps for its next run: :mod:`replication.scenes.kept`) gets its bin
+    image computed once per ``bins`` and kept while the frame lives (:mod:`replication.vision.derived`)."""
     if max(bins) > 256:
         raise ValueError(f"at most 256 bins per channel, got {bins}")
-    if frame.flags.writeable:
-        return _bin_image(frame, tuple(bins))
-    made = _BIN_IMAGES.get(id(frame))
-    if made is None or made[0]() is not frame:
-        made = _BIN_IMAGES[id(frame)] = weakref.ref(frame, lambda _, key=id(frame): _BIN_IMAGES.pop(key, None)), {}
-    image = made[1].get(tuple(bins))
-    if image is None:
-        image = made[1][tuple(bins)] = _bin_image(frame, tuple(bins))
-        image.flags.writeable = False
-    return image
-
-
-_BIN_IMAGES: dict = {}  # id of a read-only frame -> (weak reference to it, {bins: its bin image})
+    bins = tuple(bins)
+    return derived(frame, ("hsv bins", bins), lambda: _bin_image(frame, bins))
 
 
 def _bin_image(frame: np.ndarray, bins: tuple[int, int, int]) -> np.ndarray:
