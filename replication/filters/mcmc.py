@@ -152,7 +152,9 @@ class MCMCPF(JointFilter):
         held = _held(accepted, targets, m)
         rows = np.concatenate([proposals, initial])
         kept = rows[held[burn:].T]  # (M, N, d): each target's samples contiguous
-        best = np.argsort(score[burn:])[-self.carry :]
+        # ties are rejected steps, whose joint states are the same; a stable sort orders them by step on
+        # every CPU (numpy's default sort is chosen by the CPU's vector extensions)
+        best = np.argsort(score[burn:], kind="stable")[-self.carry :]
         weights = np.full(self.n_particles, 1.0 / self.n_particles)
         for i in range(m):
             state.record(i, kept[i], weights, False)
