@@ -37,6 +37,7 @@ from replication.smc.loop import (
     Summaries,
     model_proposal,
 )
+from replication.filters.frame import BoxTargets, normalise_rows
 from replication.filters.joint import JointFilter, JointState
 from replication.smc.resampling import inverse_cdf_rows, multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
@@ -61,18 +62,43 @@ def log_potential(a: np.ndarray, b: np.ndarray, beta: float) -> np.ndarray:
 
 def cloud_extents(particles: list) -> tuple[np.ndarray, np.ndarray]:
     """Each target's cloud extent, the box covering every particle's box: (M, 2) left-top and
-    right-bottom corners, from one ``reduceat`` over the stacked clouds."""
-    stacked = np.concatenate(particles)
-    starts = np.cumsum([0] + [len(p) for p in particles[:-1]])
-    half = stacked[:, 2:4] / 2
-    return np.minimum.reduceat(stacked[:, :2] - half, starts), np.maximum.reduceat(stacked[:, :2] + half, starts)
+    right-bottom corners (:func:`_extents`)."""
+    return _extents(np.ascontiguousarray(np.concatenate(particles), dtype=float), np.cumsum([len(p) for p in particles]))
+
+
+@njit(cache=True)
+def _extents(stacked, ends):
+    """Over each target's rows (up to ``ends[i]``), the least cx - w/2, cy - h/2 and the largest
+    cx + w/2, cy + h/2, NaN from the first NaN on: ``np.minimum.reduceat`` and ``np.maximum.reduceat``."""
+    low, high = np.full((ends.size, 2), np.inf), np.full((ends.size, 2), -np.inf)
+    start = 0
+    for i in range(ends.size):
+        for r in range(start, ends[i]):
+            for c in range(2):
+                half = stacked[r, c + 2] / 2
+                lower, upper = stacked[r, c] - half, stacked[r, c] + half
+                if not np.isnan(low[i, c]) and (lower < low[i, c] or np.isnan(lower)):
+                    low[i, c] = lower
+                if not np.isnan(high[i, c]) and (upper > high[i, c] or np.isnan(upper)):
+                    high[i, c] = upper
+        start = ends[i]
+    return low, high
 
 
 def neighbours(particles: list) -> list[tuple[int, int]]:
     """Pairs (i < j) of targets whose particle clouds can overlap: the MRF's edges this frame."""
-    low, high = cloud_extents(particles)
-    meet = ((low[:, None] < high[None, :]) & (low[None, :] < high[:, None])).all(axis=-1)
-    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(meet, 1)))]
+    return _meeting(*cloud_extents(particles))
+
+
+@njit(cache=True)
+def _meeting(low, high):
+    """The pairs (i < j), in order, whose extents overlap on both axes."""
+    pairs = []
+    for i in range(low.shape[0]):
+        for j in range(i + 1, low.shape[0]):
+            if low[i, 0] < high[j, 0] and low[j, 0] < high[i, 0] and low[i, 1] < high[j, 1] and low[j, 1] < high[i, 1]:
+                pairs.append((i, j))
+    return pairs
 
 
 def reaching(boxes: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
@@ -167,6 +193,9 @@ def _tally(draws, w, n):
     return out
 
 
+EVERY_STEP = ResamplingPolicy("multinomial", 1.0)  # bis_pf's step 1 resamples every frame
+
+
 @dataclass
 class DistributedState:
     """The targets of a distributed filter: one :class:`~replication.smc.loop.FilterState` each, sharing ``rng``.
@@ -178,6 +207,15 @@ class DistributedState:
     targets: list[FilterState]
     rng: np.random.Generator
     t: int = 0
+    frame: tuple = ((), None)  # the targets' models (their ids) and, as one, BoxTargets.of them
+
+    def box_targets(self) -> BoxTargets | None:
+        """The targets' models as one (:class:`~replication.filters.frame.BoxTargets`, made again when a
+        target is born or dies), or None if they cannot be."""
+        key = tuple(id(target.model) for target in self.targets)
+        if key != self.frame[0]:
+            self.frame = key, BoxTargets.of(self.models)
+        return self.frame[1]
 
     @property
     def models(self) -> list:
@@ -211,7 +249,7 @@ class DistributedFilter(JointFilter):
     targets share one random stream.
     """
 
-    resampling = ResamplingPolicy("multinomial", 1.0)
+    resampling = EVERY_STEP
 
     @property
     def loop(self) -> ParticleFilter:
@@ -233,12 +271,40 @@ class DistributedFilter(JointFilter):
         del state.targets[index]
 
     def step(self, state: DistributedState, z) -> None:
+        boxes = state.box_targets() if state.targets and self.resampling == EVERY_STEP else None
+        if boxes is not None:
+            return self.whole_frame(state, z, boxes)
         loop = self.loop
         state.t += 1
         weighed = [loop.weigh(target, z) for target in state.targets]
         final = self.interact([w.particles for w in weighed], [w.weights for w in weighed], state)
         for target, w, weights in zip(state.targets, weighed, final):
             loop.conclude(target, w.reweighted(weights))
+
+    def whole_frame(self, state: DistributedState, z, boxes: BoxTargets) -> None:
+        """:meth:`step` with every target's motion, likelihood, weights and resampling done for all targets
+        at once (:mod:`replication.filters.frame`): the loop's weigh of each target, the interaction, then
+        its conclude, with the same random draws in the same order and the same numbers."""
+        targets, n, rng = state.targets, self.n_particles, state.rng
+        m = len(targets)
+        state.t += 1
+        for target in targets:
+            target.t += 1
+        offsets = np.arange(m + 1) * n
+        moved = boxes.propagate(np.concatenate([target.particles for target in targets]), offsets, state.t, rng)
+        log_likelihood = boxes.log_likelihood(moved, offsets, z, state.t).reshape(m, n)
+        weights, log_totals, degenerate = normalise_rows(np.stack([target.log_weights for target in targets]), log_likelihood)
+        moved = moved.reshape(m, n, -1)
+        final = self.interact(list(moved), list(weights), state)
+        for target, particles, pi, log_total, flag in zip(targets, moved, final, log_totals, degenerate):
+            target.log_evidence += log_total
+            target.records.add(particles, pi, bool(flag))
+            target.records.resampled.append(True)
+        ancestors = inverse_cdf_rows(np.stack(final), rng.random((m, n)))  # each target's multinomial, in turn
+        resampled = np.take_along_axis(moved, ancestors[:, :, None], axis=1)
+        log_weights = np.full((m, n), -np.log(n))
+        for target, particles, uniform in zip(targets, resampled, log_weights):
+            target.particles, target.log_weights = particles, uniform
 
 
 @dataclass
