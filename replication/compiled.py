@@ -1,5 +1,5 @@
-"""The project's numba conventions: scalar functions compiled into numpy ufuncs, and numpy's own order of a
-sum for compiled kernels that must give numpy's bits."""
+"""The project's numba conventions: scalar functions compiled into numpy ufuncs, and, for compiled kernels
+that must give numpy's bits, numpy's own order of a sum and its BLAS calls."""
 
 from functools import lru_cache
 
@@ -82,3 +82,12 @@ def pairwise_sum(values, program):
             stack[depth] = _block_sum(values, program[p, 0], program[p, 1])
             depth += 1
     return stack[0]
+
+
+@njit(cache=True)
+def matvec(matrix, vector):
+    """``matrix @ vector`` as numpy computes it: BLAS's dot product for a one-row matrix, its matrix-vector
+    product otherwise, for a C- or F-contiguous matrix (numba calls the same BLAS kernels: tested)."""
+    if matrix.shape[0] == 1:
+        return np.array([np.dot(np.ascontiguousarray(matrix[0]), vector)])
+    return np.dot(matrix, vector)

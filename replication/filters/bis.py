@@ -24,7 +24,7 @@ so the two differ only in inference); resampled jointly every frame.  Its cost
 and variance grow exponentially with the number of targets.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
@@ -37,7 +37,7 @@ from replication.smc.loop import (
     Summaries,
     model_proposal,
 )
-from replication.filters.frame import BoxTargets, normalise_rows
+from replication.filters.frame import BoxTargets, Targets, gather_rows, normalise_rows
 from replication.filters.joint import JointFilter, JointState
 from replication.smc.resampling import inverse_cdf_rows, multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
@@ -207,15 +207,11 @@ class DistributedState:
     targets: list[FilterState]
     rng: np.random.Generator
     t: int = 0
-    frame: tuple = ((), None)  # the targets' models (their ids) and, as one, BoxTargets.of them
+    as_one: Targets = field(default_factory=Targets)
 
     def box_targets(self) -> BoxTargets | None:
-        """The targets' models as one (:class:`~replication.filters.frame.BoxTargets`, made again when a
-        target is born or dies), or None if they cannot be."""
-        key = tuple(id(target.model) for target in self.targets)
-        if key != self.frame[0]:
-            self.frame = key, BoxTargets.of(self.models)
-        return self.frame[1]
+        """The targets' models as one (:class:`~replication.filters.frame.BoxTargets`), or None."""
+        return self.as_one(self.models)
 
     @property
     def models(self) -> list:
@@ -293,7 +289,8 @@ class DistributedFilter(JointFilter):
         offsets = np.arange(m + 1) * n
         moved = boxes.propagate(np.concatenate([target.particles for target in targets]), offsets, state.t, rng)
         log_likelihood = boxes.log_likelihood(moved, offsets, z, state.t).reshape(m, n)
-        weights, log_totals, degenerate = normalise_rows(np.stack([target.log_weights for target in targets]), log_likelihood)
+        weights, log_totals, degenerate = normalise_rows(np.stack([target.log_weights for target in targets]), log_likelihood,
+                                                          corrected=True)
         moved = moved.reshape(m, n, -1)
         final = self.interact(list(moved), list(weights), state)
         for target, particles, pi, log_total, flag in zip(targets, moved, final, log_totals, degenerate):
@@ -301,7 +298,7 @@ class DistributedFilter(JointFilter):
             target.records.add(particles, pi, bool(flag))
             target.records.resampled.append(True)
         ancestors = inverse_cdf_rows(np.stack(final), rng.random((m, n)))  # each target's multinomial, in turn
-        resampled = np.take_along_axis(moved, ancestors[:, :, None], axis=1)
+        resampled = gather_rows(moved, ancestors)
         log_weights = np.full((m, n), -np.log(n))
         for target, particles, uniform in zip(targets, resampled, log_weights):
             target.particles, target.log_weights = particles, uniform
@@ -367,5 +364,7 @@ class MRFJPF(JointFilter):
             degenerate = False
         except DegenerateWeightsError:
             weights, degenerate = np.full(n, 1.0 / n), True
+        with np.errstate(divide="ignore"):
+            log_weights = np.log(weights)
         for i, particles in enumerate(moved):
-            state.record(i, particles, weights, degenerate)
+            state.record(i, particles, weights, degenerate, log_weights)

@@ -18,6 +18,8 @@ from numba import njit
 from replication.compiled import pairwise_program, pairwise_sum
 from replication.errors import NotFinite
 from replication.models.box import BoxModel, _moved
+from replication.smc.loop import ParticleFilter, prior_proposal
+from replication.smc.resampling import inverse_cdf_rows
 from replication.smc.weights import DegenerateWeightsError
 from replication.smc.work import Counted
 from replication.vision.joint import ColourLikelihoods
@@ -45,12 +47,17 @@ class BoxTargets:
         likelihoods = ColourLikelihoods.of([box.likelihood for box in boxes])
         return None if likelihoods is None else cls(models, boxes, likelihoods)
 
-    def propagate(self, particles: np.ndarray, offsets: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray:
+    def propagate(self, particles: np.ndarray, offsets: np.ndarray, t: int, rng) -> np.ndarray:
         """Each target's ``BoxModel.propagate`` of its rows, in target order: its (blocks, n_i, width)
-        normals are the next slice of one draw."""
+        normals are the next slice of one draw from ``rng``, or its own draw from its own generator
+        (``rng`` a list of them: independent filters)."""
         sources, first = self.first._sources, self.first
         self._count("propagations", offsets, t)
-        draws = rng.standard_normal(sources.blocks * len(particles) * sources.width)
+        per_row = sources.blocks * sources.width
+        if isinstance(rng, np.random.Generator):
+            draws = rng.standard_normal(per_row * len(particles))
+        else:
+            draws = np.concatenate([own.standard_normal(per_row * int(n)) for own, n in zip(rng, np.diff(offsets))])
         return _moved_targets(particles, draws, np.asarray(offsets, dtype=np.int64), sources.blocks, sources.width,
                               sources.block, sources.column, sources.scale, first.kind == "constant_velocity",
                               float(first.period), float(first.min_size))
@@ -64,6 +71,59 @@ class BoxTargets:
         for work, n in zip(self.works, np.diff(offsets)):
             if work is not None:
                 getattr(work, what)[t] += int(n)
+
+
+def independent_frame(filters: list, states: list, boxes: BoxTargets, frame) -> bool:
+    """One step of independent bootstrap filters (:class:`~replication.smc.loop.ParticleFilter` with the prior
+    proposal, no move, multinomial resampling: MIPF's on the balls), every target at once: the loop's weigh
+    and conclude of each target, each from its own generator (its normals, then its uniforms if it
+    resamples), with the same numbers.  False, doing nothing, for filters this does not cover."""
+    first = filters[0]
+    if not all(type(f) is ParticleFilter and f.proposal is prior_proposal and f.move is None and f.n_particles == first.n_particles
+               and f.resampling == first.resampling for f in filters) or first.resampling.scheme != "multinomial":
+        return False
+    m, n = len(states), first.n_particles
+    for state in states:
+        state.t += 1
+    offsets = np.arange(m + 1) * n
+    moved = boxes.propagate(np.concatenate([s.particles for s in states]), offsets, states[0].t, [s.rng for s in states])
+    log_likelihood = boxes.log_likelihood(moved, offsets, frame, states[0].t).reshape(m, n)
+    predicted = np.stack([s.log_weights for s in states])
+    weights, log_totals, degenerate = normalise_rows(predicted, log_likelihood, corrected=False)
+    moved = moved.reshape(m, n, -1)
+    resampling = []
+    for i, state in enumerate(states):
+        state.log_evidence += log_totals[i]
+        state.records.add(moved[i], weights[i], bool(degenerate[i]))
+        wants = first.resampling.wants(state.records.ess[-1], n)
+        state.records.resampled.append(wants)
+        if wants:
+            resampling.append(i)
+        else:  # the weighed log-weights, as Weighed.log_weights forms them
+            unnormalised = predicted[i] if degenerate[i] else predicted[i] + log_likelihood[i]
+            state.particles, state.log_weights = moved[i], unnormalised - log_totals[i]
+    if resampling:
+        uniforms = np.stack([states[i].rng.random(n) for i in resampling])
+        resampled = gather_rows(moved[resampling], inverse_cdf_rows(weights[resampling], uniforms))
+        uniform = np.full((len(resampling), n), -np.log(n))
+        for i, particles, log_weights in zip(resampling, resampled, uniform):
+            states[i].particles, states[i].log_weights = particles, log_weights
+    return True
+
+
+class Targets:
+    """A joint filter's state's view of its models as one: ``targets(models)`` is ``BoxTargets.of(models)``,
+    made again only when the models change (a target born or dead); the models themselves are taken not
+    to change (a colour likelihood's reference is fixed)."""
+
+    def __init__(self):
+        self.models, self.made = (), None
+
+    def __call__(self, models: list) -> BoxTargets | None:
+        key = tuple(id(model) for model in models)
+        if key != self.models:
+            self.models, self.made = key, BoxTargets.of(models)
+        return self.made
 
 
 def _same_motion(box: BoxModel, other: BoxModel) -> bool:
@@ -84,14 +144,16 @@ def _moved_targets(particles, draws, offsets, blocks, width, block, column, scal
     return out
 
 
-def normalise_rows(log_weights: np.ndarray, log_likelihood: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The loop's weighting of each target (``ParticleFilter.weigh`` after the prior proposal, whose log p/q
-    is 0) for rows (M, N): ``log_weights + 0 + log_likelihood`` normalised (:func:`normalise_in_place`),
-    or where a row is all -inf its predicted ``log_weights + 0`` (a degenerate step): (weights, log-sums,
-    degenerate).  Raises what :func:`~replication.smc.weights.normalise` raises where even that fails."""
+def normalise_rows(log_weights: np.ndarray, log_likelihood: np.ndarray, corrected: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The loop's weighting of each target (``ParticleFilter.weigh``) for rows (M, N): the predicted
+    ``log_weights`` (plus 0 when ``corrected``: the log p / q that ``model_proposal`` adds, 0 for a box
+    model; the prior proposal adds nothing), plus ``log_likelihood``, normalised
+    (:func:`normalise_in_place`), or where a row is all -inf the predicted weights (a degenerate step):
+    (weights, log-sums, degenerate).  Raises what :func:`~replication.smc.weights.normalise` raises where
+    even that fails."""
     weights, log_totals, degenerate = np.empty_like(log_weights), np.empty(len(log_weights)), np.zeros(len(log_weights), bool)
-    refuse(_normalise_rows(log_weights, log_likelihood, pairwise_program(log_weights.shape[1]), weights, log_totals,
-                           degenerate))
+    refuse(_normalise_rows(log_weights, log_likelihood, corrected, pairwise_program(log_weights.shape[1]), weights,
+                           log_totals, degenerate))
     return weights, log_totals, degenerate
 
 
@@ -107,21 +169,26 @@ def refuse(status: int) -> None:
 
 
 @njit(cache=True)
-def _normalise_rows(log_weights, log_likelihood, program, weights, log_totals, degenerate):
+def _normalise_rows(log_weights, log_likelihood, corrected, program, weights, log_totals, degenerate):
     """Into ``weights`` etc. row by row; stops at a row it cannot weight, returning why (else 0)."""
     for i in range(log_weights.shape[0]):
         row = weights[i]
         for k in range(row.size):
-            row[k] = (log_weights[i, k] + 0.0) + log_likelihood[i, k]
+            row[k] = _predicted(log_weights[i, k], corrected) + log_likelihood[i, k]
         status, log_totals[i] = normalise_in_place(row, program)
         if status == DEGENERATE:  # no particle explains the frame: keep the predicted weights
             degenerate[i] = True
             for k in range(row.size):
-                row[k] = log_weights[i, k] + 0.0
+                row[k] = _predicted(log_weights[i, k], corrected)
             status, log_totals[i] = normalise_in_place(row, program)
         if status:
             return status
     return 0
+
+
+@njit(cache=True, inline="always")
+def _predicted(log_weight, corrected):
+    return log_weight + 0.0 if corrected else log_weight
 
 
 @njit(cache=True)
@@ -140,6 +207,18 @@ def normalise_in_place(row, program):
     for k in range(row.size):
         row[k] = row[k] / total
     return 0, top + np.log(total)
+
+
+@njit(cache=True)
+def gather_rows(particles, ancestors):
+    """Each target's resampled particles, ``particles[i][ancestors[i]]`` for particles (M, N, d) and
+    ancestors (M, N'), in one pass."""
+    m, count = ancestors.shape
+    out = np.empty((m, count, particles.shape[2]))
+    for i in range(m):
+        for k in range(count):
+            out[i, k] = particles[i, ancestors[i, k]]
+    return out
 
 
 @njit(cache=True)

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from numba.typed import List
 
-from replication.compiled import pairwise_program
+from replication.compiled import matvec, pairwise_program
 from replication.filters.bis import DistributedFilter, _meeting, cloud_extents, log_potential_table
 from replication.filters.frame import normalise_in_place, refuse
 from replication.filters.joint import JointState
@@ -50,7 +50,7 @@ def _mean_field(states, pi, low, high, pairs, beta, iterations, program):
 
     A pair's block holds log psi between i's particles reaching j's extent (``low``, ``high``) and j's
     reaching i's; each iteration adds, pair by pair, block @ q_j to i's field and block^T @ q_i to j's
-    (:func:`_product`: numpy's BLAS calls), then normalises pi_i exp(field_i) as
+    (:func:`~replication.compiled.matvec`: numpy's BLAS calls), then normalises pi_i exp(field_i) as
     :func:`~replication.smc.weights.normalise` does (:func:`~replication.filters.frame.normalise_in_place`):
     the numbers of the numpy form to the bit."""
     m, n = pi.shape
@@ -68,10 +68,10 @@ def _mean_field(states, pi, low, high, pairs, beta, iterations, program):
             i, j, block = pairs[p, 0], pairs[p, 1], blocks[p]
             if block.shape[0] == 0 or block.shape[1] == 0:  # numpy adds nothing, or exact zeros
                 continue
-            to_i = _product(block, q[j][cols[p]], False)
+            to_i = matvec(block, q[j][cols[p]])
             for r in range(rows[p].size):
                 field[i, rows[p][r]] += to_i[r]
-            to_j = _product(block, q[i][rows[p]], True)
+            to_j = matvec(block.T, q[i][rows[p]])
             for c in range(cols[p].size):
                 field[j, cols[p][c]] += to_j[c]
         q = np.empty((m, n))
@@ -98,16 +98,3 @@ def _reaching(boxes, low, high):
             keep[count] = r
             count += 1
     return keep[:count]
-
-
-@njit(cache=True)
-def _product(block, vector, transposed):
-    """``block @ vector`` (or ``block.T @ vector``) as numpy computes it: BLAS's dot product for a one-row
-    matrix, its matrix-vector product otherwise (numba calls the same BLAS kernels)."""
-    if transposed:
-        if block.shape[1] == 1:
-            return np.array([np.dot(np.ascontiguousarray(block[:, 0]), vector)])
-        return np.dot(block.T, vector)
-    if block.shape[0] == 1:
-        return np.array([np.dot(block[0], vector)])
-    return np.dot(block, vector)

@@ -375,17 +375,18 @@ def _cell(corner, beta, reach):
     (the same pixels); safe when f lies farther than eps from 0, 1 and every beta_i, eps = 1e-6 (|o| +
     max |s_i| + 1): sixteen times float32's rounding of o + s_i.  The beta_i are sorted, so the count is
     a binary search and the nearest beta_i is one of the two about f (a rounded difference is monotone in
-    beta_i, so this is the nearest of all of them, to the bit)."""
+    beta_i, so this is the nearest of all of them, to the bit).  ``f >= beta_i`` and ``beta_i <= f`` are
+    one test."""
     whole = np.floor(corner)
     f = corner - whole
     nearest = min(f, 1.0 - f)
-    count, above = 0, beta.size  # the first beta_i > f lies in [count, above]
-    while count < above:
-        middle = (count + above) // 2
-        if f >= beta[middle]:
-            count = middle + 1
-        else:
-            above = middle
+    count, size = 0, beta.size  # beta[:count] <= f; the rest of them within the next size
+    while size > 1:  # without a branch on the data: one comparison and a select a halving
+        half = size // 2
+        count = count + half if beta[count + half - 1] <= f else count
+        size -= half
+    if size == 1 and beta[count] <= f:
+        count += 1
     if count > 0:
         nearest = min(nearest, abs(f - beta[count - 1]))
     if count < beta.size:
