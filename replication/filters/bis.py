@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from replication.compiled import pairwise_program, pairwise_sum
 from replication.smc.loop import (
     FilterOutput,
     FilterState,
@@ -123,17 +124,18 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
     inverse CDF of :func:`~replication.smc.resampling.multinomial` (for targets of one N, all rows in
     one call: :func:`~replication.smc.resampling.inverse_cdf_rows`); the potentials of the
     neighbouring pairs and the K-draw tallies are compiled loops over the drawn indices
-    (:func:`_draw_log_potential`, :func:`_tally`), with no (K, 4) copy of each target's drawn
-    states; the arithmetic and its order are those of :func:`pairwise_log_potential` and
-    ``np.bincount``, so the histograms are the same to the bit.
+    (:func:`_draw_log_potential`, :func:`_marginals`), with no (K, 4) copy of each target's drawn
+    states; the arithmetic and its order are those of :func:`pairwise_log_potential`,
+    ``np.bincount`` and numpy's sums, so the histograms are the same to the bit.
     """
     pairs = np.array(neighbours(particles), dtype=np.int64).reshape(-1, 2)  # eq (8); draws lie in their clouds
     if len({len(p) for p in particles}) == 1:
+        n = len(pi[0])
         draws = inverse_cdf_rows(np.stack(pi), rng.random((len(pi), k)))  # B_i(k), eq (5): one pass for all targets
         log_w = _draw_log_potential(np.stack(particles).astype(float, copy=False), draws, pairs, float(beta))
-    else:  # targets with different N: the numpy form
-        draws = np.stack([multinomial(p, rng, size=k) for p in pi])
-        log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
+        return list(_marginals(draws, log_w, n, pairwise_program(n)))
+    draws = np.stack([multinomial(p, rng, size=k) for p in pi])  # targets with different N: the numpy form
+    log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
     tallies = _tally(draws, w, max(len(p) for p in particles))
     return [h[: len(p)] / h[: len(p)].sum() for h, p in zip(tallies, particles)]  # np.bincount's minlength=len(p)
@@ -173,14 +175,35 @@ def log_potential_table(a, b, beta):
 
 @njit(cache=True, error_model="numpy")
 def _draw_log_potential(states, draws, pairs, beta):
-    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k."""
+    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k (each
+    particle's :func:`_edges` formed once)."""
+    edges = np.empty((states.shape[0], states.shape[1], 6))
+    for i in range(states.shape[0]):
+        for n in range(states.shape[1]):
+            edges[i, n] = _edges(states[i, n])
     total = np.zeros(draws.shape[1])
     for p in range(pairs.shape[0]):
         i, j = pairs[p, 0], pairs[p, 1]
         for k in range(draws.shape[1]):
-            a, b = states[i, draws[i, k]], states[j, draws[j, k]]
-            total[k] += _log_phi(_edges(a), a[2] * a[3], _edges(b), beta)
+            a, b = edges[i, draws[i, k]], edges[j, draws[j, k]]
+            total[k] += _log_phi(a, a[4] * a[5], b, beta)
     return total
+
+
+@njit(cache=True)
+def _marginals(draws, log_w, n, program):
+    """W_i (M, n) from the draws and their log MRF weights: ``w = exp(log_w - max)``, each target's
+    :func:`_tally`, divided by its sum (numpy's order: ``program``)."""
+    top = log_w.max() if not np.isnan(log_w).any() else np.nan
+    w = np.empty(log_w.size)
+    for k in range(log_w.size):
+        w[k] = np.exp(log_w[k] - top)
+    out = _tally(draws, w, n)
+    for i in range(out.shape[0]):
+        total = pairwise_sum(out[i], program)
+        for u in range(n):
+            out[i, u] = out[i, u] / total
+    return out
 
 
 @njit(cache=True)

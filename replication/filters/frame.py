@@ -17,7 +17,7 @@ from numba import njit
 
 from replication.compiled import pairwise_program, pairwise_sum
 from replication.errors import NotFinite
-from replication.models.box import BoxModel, _moved
+from replication.models.box import BoxModel
 from replication.smc.loop import ParticleFilter, prior_proposal
 from replication.smc.resampling import inverse_cdf_rows
 from replication.smc.weights import DegenerateWeightsError
@@ -51,16 +51,14 @@ class BoxTargets:
         """Each target's ``BoxModel.propagate`` of its rows, in target order: its (blocks, n_i, width)
         normals are the next slice of one draw from ``rng``, or its own draw from its own generator
         (``rng`` a list of them: independent filters)."""
-        sources, first = self.first._sources, self.first
+        first = self.first
         self._count("propagations", offsets, t)
-        per_row = sources.blocks * sources.width
+        per_row = first._sources.blocks * first._sources.width
         if isinstance(rng, np.random.Generator):
             draws = rng.standard_normal(per_row * len(particles))
         else:
             draws = np.concatenate([own.standard_normal(per_row * int(n)) for own, n in zip(rng, np.diff(offsets))])
-        return _moved_targets(particles, draws, np.asarray(offsets, dtype=np.int64), sources.blocks, sources.width,
-                              sources.block, sources.column, sources.scale, first.kind == "constant_velocity",
-                              float(first.period), float(first.min_size))
+        return first.moved(particles, draws, offsets)
 
     def log_likelihood(self, particles: np.ndarray, offsets: np.ndarray, frame, t: int) -> np.ndarray:
         """Each target's ``BoxModel.log_likelihood`` of its rows, the frame's features computed once."""
@@ -130,18 +128,6 @@ def _same_motion(box: BoxModel, other: BoxModel) -> bool:
     return (box.kind == other.kind and box.period == other.period and box.min_size == other.min_size
             and box._sources.blocks == other._sources.blocks and box._sources.width == other._sources.width
             and all(np.array_equal(a, b) for a, b in zip(box._sources[2:], other._sources[2:])))
-
-
-@njit(cache=True, error_model="numpy")
-def _moved_targets(particles, draws, offsets, blocks, width, block, column, scale, constant_velocity, period, min_size):
-    """:func:`~replication.models.box._moved` of each target's rows with its slice of ``draws``."""
-    out = np.empty_like(particles)
-    for i in range(offsets.size - 1):
-        first, last = offsets[i], offsets[i + 1]
-        n = last - first
-        own = draws[blocks * width * first : blocks * width * last].reshape((blocks, n, width))
-        out[first:last] = _moved(particles[first:last], own, block, column, scale, constant_velocity, period, min_size)
-    return out
 
 
 def normalise_rows(log_weights: np.ndarray, log_likelihood: np.ndarray, corrected: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -373,24 +373,14 @@ def _edges_of_cells(offsets, scale):
 def _cell(corner, beta, reach):
     """(n, #{i : beta_i <= f}, safe) of a box corner o = n + f, f past every beta_i counted as n + 1 and none
     (the same pixels); safe when f lies farther than eps from 0, 1 and every beta_i, eps = 1e-6 (|o| +
-    max |s_i| + 1): sixteen times float32's rounding of o + s_i.  The beta_i are sorted, so the count is
-    a binary search and the nearest beta_i is one of the two about f (a rounded difference is monotone in
-    beta_i, so this is the nearest of all of them, to the bit).  ``f >= beta_i`` and ``beta_i <= f`` are
-    one test."""
+    max |s_i| + 1): sixteen times float32's rounding of o + s_i."""
     whole = np.floor(corner)
     f = corner - whole
     nearest = min(f, 1.0 - f)
-    count, size = 0, beta.size  # beta[:count] <= f; the rest of them within the next size
-    while size > 1:  # without a branch on the data: one comparison and a select a halving
-        half = size // 2
-        count = count + half if beta[count + half - 1] <= f else count
-        size -= half
-    if size == 1 and beta[count] <= f:
-        count += 1
-    if count > 0:
-        nearest = min(nearest, abs(f - beta[count - 1]))
-    if count < beta.size:
-        nearest = min(nearest, abs(f - beta[count]))
+    count = 0
+    for i in range(beta.size):
+        nearest = min(nearest, abs(f - beta[i]))
+        count += f >= beta[i]
     safe = nearest > 1e-6 * (abs(corner) + reach + 1.0) and abs(whole) < 2.0**52
     if count == beta.size:
         whole, count = whole + 1.0, 0
