@@ -182,10 +182,14 @@ def _draw_log_potential(states, draws, pairs, beta):
         for n in range(states.shape[1]):
             edges[i, n] = _edges(states[i, n])
     total = np.zeros(draws.shape[1])
+    finite = beta < np.inf
     for p in range(pairs.shape[0]):
         i, j = pairs[p, 0], pairs[p, 1]
         for k in range(draws.shape[1]):
             a, b = edges[i, draws[i, k]], edges[j, draws[j, k]]
+            if (finite and min(a[0], b[0]) - max(a[1], b[1]) < 0 and min(a[2], b[2]) - max(a[3], b[3]) < np.inf
+                    and a[4] * a[5] * b[4] * b[5] > 0):
+                continue  # apart along x: log phi is -0.0, adding nothing (where no NaN or infinity would arise)
             total[k] += _log_phi(a, a[4] * a[5], b, beta)
     return total
 

@@ -31,7 +31,9 @@ class BoxTargets:
     (:class:`~replication.smc.work.Counted`)."""
 
     def __init__(self, models: list, boxes: list[BoxModel], likelihoods: ColourLikelihoods):
-        self.works = [model.work if isinstance(model, Counted) else None for model in models]
+        works = [model.work if isinstance(model, Counted) else None for model in models]
+        self.works = ([(works[0], len(works))] if works[0] is not None and all(w is works[0] for w in works)  # a run's tally
+                      else [(work, 1) for work in works])  # each tally, and how many targets in a row count into it
         self.first, self.likelihoods = boxes[0], likelihoods
 
     @classmethod
@@ -66,9 +68,12 @@ class BoxTargets:
         return self.likelihoods.log_likelihood(particles, offsets, self.first.prepared(frame, t))
 
     def _count(self, what: str, offsets: np.ndarray, t: int) -> None:
-        for work, n in zip(self.works, np.diff(offsets)):
+        """Each target's rows added to its tally at step t, as its own call would (integers: in any order)."""
+        first = 0
+        for work, targets in self.works:
             if work is not None:
-                getattr(work, what)[t] += int(n)
+                getattr(work, what)[t] += int(offsets[first + targets] - offsets[first])
+            first += targets
 
 
 def independent_frame(filters: list, states: list, boxes: BoxTargets, frame) -> bool:
