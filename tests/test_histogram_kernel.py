@@ -6,13 +6,8 @@ import numpy as np
 import pytest
 
 from replication.vision.colour import ColourLikelihood
-from replication.vision.histogram import (
-    KERNELS,
-    ColourHistogram,
-    _pairwise_program,
-    _pairwise_sum,
-    hsv_bin_image,
-)
+from replication.compiled import pairwise_program, pairwise_sum
+from replication.vision.histogram import KERNELS, ColourHistogram, hsv_bin_image
 from replication.vision.likelihood import gaussian_similarity_log_likelihood
 
 
@@ -75,14 +70,13 @@ def test_a_group_of_boxes_inside_and_one_outside_agree():
     np.testing.assert_allclose(rho, rho_numpy, rtol=0, atol=1e-13)
 
 
-def test_the_diagonal_total_is_numpys_sum_to_the_bit():
+def test_the_pairwise_sum_is_numpys_sum_to_the_bit():
+    """The kernel's diagonal totals and the compiled normalisations sum as ndarray.sum does."""
     rng = np.random.default_rng(0)
-    stack = np.empty(64)
-    for n in [1, 7, 8, 9, 127, 128, 129, 255, 256, 1000, 1600, 4097]:
-        weights, a, d, share = rng.random(n), rng.random(n), rng.random(n), rng.random()
-        program = _pairwise_program(n)
-        assert _pairwise_sum(weights, a, d, -1.0, program, stack) == weights.sum()
-        assert _pairwise_sum(weights, a, d, share, program, stack) == (a - share * d).sum()
+    for n in [1, 7, 8, 9, 127, 128, 129, 255, 256, 400, 1000, 1600, 4097, 12000]:
+        values = rng.random(n) * np.exp(rng.normal(0, 20, n))
+        assert pairwise_sum(values, pairwise_program(n)) == values.sum()
+    assert np.signbit(pairwise_sum(np.array([-0.0]), pairwise_program(1))) == np.signbit(np.array([-0.0]).sum())
 
 
 @pytest.mark.parametrize("kernel", KERNELS)

@@ -24,11 +24,12 @@ so the two differ only in inference); resampled jointly every frame.  Its cost
 and variance grow exponentially with the number of targets.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 
+from replication.compiled import pairwise_program, pairwise_sum
 from replication.smc.loop import (
     FilterOutput,
     FilterState,
@@ -37,6 +38,7 @@ from replication.smc.loop import (
     Summaries,
     model_proposal,
 )
+from replication.filters.frame import BoxTargets, Targets, gather_rows, normalise_rows
 from replication.filters.joint import JointFilter, JointState
 from replication.smc.resampling import inverse_cdf_rows, multinomial
 from replication.smc.weights import DegenerateWeightsError, normalise
@@ -61,18 +63,43 @@ def log_potential(a: np.ndarray, b: np.ndarray, beta: float) -> np.ndarray:
 
 def cloud_extents(particles: list) -> tuple[np.ndarray, np.ndarray]:
     """Each target's cloud extent, the box covering every particle's box: (M, 2) left-top and
-    right-bottom corners, from one ``reduceat`` over the stacked clouds."""
-    stacked = np.concatenate(particles)
-    starts = np.cumsum([0] + [len(p) for p in particles[:-1]])
-    half = stacked[:, 2:4] / 2
-    return np.minimum.reduceat(stacked[:, :2] - half, starts), np.maximum.reduceat(stacked[:, :2] + half, starts)
+    right-bottom corners (:func:`_extents`)."""
+    return _extents(np.ascontiguousarray(np.concatenate(particles), dtype=float), np.cumsum([len(p) for p in particles]))
+
+
+@njit(cache=True)
+def _extents(stacked, ends):
+    """Over each target's rows (up to ``ends[i]``), the least cx - w/2, cy - h/2 and the largest
+    cx + w/2, cy + h/2, NaN from the first NaN on: ``np.minimum.reduceat`` and ``np.maximum.reduceat``."""
+    low, high = np.full((ends.size, 2), np.inf), np.full((ends.size, 2), -np.inf)
+    start = 0
+    for i in range(ends.size):
+        for r in range(start, ends[i]):
+            for c in range(2):
+                half = stacked[r, c + 2] / 2
+                lower, upper = stacked[r, c] - half, stacked[r, c] + half
+                if not np.isnan(low[i, c]) and (lower < low[i, c] or np.isnan(lower)):
+                    low[i, c] = lower
+                if not np.isnan(high[i, c]) and (upper > high[i, c] or np.isnan(upper)):
+                    high[i, c] = upper
+        start = ends[i]
+    return low, high
 
 
 def neighbours(particles: list) -> list[tuple[int, int]]:
     """Pairs (i < j) of targets whose particle clouds can overlap: the MRF's edges this frame."""
-    low, high = cloud_extents(particles)
-    meet = ((low[:, None] < high[None, :]) & (low[None, :] < high[:, None])).all(axis=-1)
-    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(meet, 1)))]
+    return _meeting(*cloud_extents(particles))
+
+
+@njit(cache=True)
+def _meeting(low, high):
+    """The pairs (i < j), in order, whose extents overlap on both axes."""
+    pairs = []
+    for i in range(low.shape[0]):
+        for j in range(i + 1, low.shape[0]):
+            if low[i, 0] < high[j, 0] and low[j, 0] < high[i, 0] and low[i, 1] < high[j, 1] and low[j, 1] < high[i, 1]:
+                pairs.append((i, j))
+    return pairs
 
 
 def reaching(boxes: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
@@ -97,17 +124,18 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
     inverse CDF of :func:`~replication.smc.resampling.multinomial` (for targets of one N, all rows in
     one call: :func:`~replication.smc.resampling.inverse_cdf_rows`); the potentials of the
     neighbouring pairs and the K-draw tallies are compiled loops over the drawn indices
-    (:func:`_draw_log_potential`, :func:`_tally`), with no (K, 4) copy of each target's drawn
-    states; the arithmetic and its order are those of :func:`pairwise_log_potential` and
-    ``np.bincount``, so the histograms are the same to the bit.
+    (:func:`_draw_log_potential`, :func:`_marginals`), with no (K, 4) copy of each target's drawn
+    states; the arithmetic and its order are those of :func:`pairwise_log_potential`,
+    ``np.bincount`` and numpy's sums, so the histograms are the same to the bit.
     """
     pairs = np.array(neighbours(particles), dtype=np.int64).reshape(-1, 2)  # eq (8); draws lie in their clouds
     if len({len(p) for p in particles}) == 1:
+        n = len(pi[0])
         draws = inverse_cdf_rows(np.stack(pi), rng.random((len(pi), k)))  # B_i(k), eq (5): one pass for all targets
         log_w = _draw_log_potential(np.stack(particles).astype(float, copy=False), draws, pairs, float(beta))
-    else:  # targets with different N: the numpy form
-        draws = np.stack([multinomial(p, rng, size=k) for p in pi])
-        log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
+        return list(_marginals(draws, log_w, n, pairwise_program(n)))
+    draws = np.stack([multinomial(p, rng, size=k) for p in pi])  # targets with different N: the numpy form
+    log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
     tallies = _tally(draws, w, max(len(p) for p in particles))
     return [h[: len(p)] / h[: len(p)].sum() for h, p in zip(tallies, particles)]  # np.bincount's minlength=len(p)
@@ -147,14 +175,39 @@ def log_potential_table(a, b, beta):
 
 @njit(cache=True, error_model="numpy")
 def _draw_log_potential(states, draws, pairs, beta):
-    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k."""
+    """sum over the pairs (i, j) of log phi(x_i[B_i(k)], x_j[B_j(k)]) for every joint draw k (each
+    particle's :func:`_edges` formed once)."""
+    edges = np.empty((states.shape[0], states.shape[1], 6))
+    for i in range(states.shape[0]):
+        for n in range(states.shape[1]):
+            edges[i, n] = _edges(states[i, n])
     total = np.zeros(draws.shape[1])
+    finite = beta < np.inf
     for p in range(pairs.shape[0]):
         i, j = pairs[p, 0], pairs[p, 1]
         for k in range(draws.shape[1]):
-            a, b = states[i, draws[i, k]], states[j, draws[j, k]]
-            total[k] += _log_phi(_edges(a), a[2] * a[3], _edges(b), beta)
+            a, b = edges[i, draws[i, k]], edges[j, draws[j, k]]
+            if (finite and min(a[0], b[0]) - max(a[1], b[1]) < 0 and min(a[2], b[2]) - max(a[3], b[3]) < np.inf
+                    and a[4] * a[5] * b[4] * b[5] > 0):
+                continue  # apart along x: log phi is -0.0, adding nothing (where no NaN or infinity would arise)
+            total[k] += _log_phi(a, a[4] * a[5], b, beta)
     return total
+
+
+@njit(cache=True)
+def _marginals(draws, log_w, n, program):
+    """W_i (M, n) from the draws and their log MRF weights: ``w = exp(log_w - max)``, each target's
+    :func:`_tally`, divided by its sum (numpy's order: ``program``)."""
+    top = log_w.max() if not np.isnan(log_w).any() else np.nan
+    w = np.empty(log_w.size)
+    for k in range(log_w.size):
+        w[k] = np.exp(log_w[k] - top)
+    out = _tally(draws, w, n)
+    for i in range(out.shape[0]):
+        total = pairwise_sum(out[i], program)
+        for u in range(n):
+            out[i, u] = out[i, u] / total
+    return out
 
 
 @njit(cache=True)
@@ -165,6 +218,9 @@ def _tally(draws, w, n):
         for k in range(draws.shape[1]):
             out[i, draws[i, k]] += w[k]
     return out
+
+
+EVERY_STEP = ResamplingPolicy("multinomial", 1.0)  # bis_pf's step 1 resamples every frame
 
 
 @dataclass
@@ -178,6 +234,11 @@ class DistributedState:
     targets: list[FilterState]
     rng: np.random.Generator
     t: int = 0
+    as_one: Targets = field(default_factory=Targets)
+
+    def box_targets(self) -> BoxTargets | None:
+        """The targets' models as one (:class:`~replication.filters.frame.BoxTargets`), or None."""
+        return self.as_one(self.models)
 
     @property
     def models(self) -> list:
@@ -211,7 +272,7 @@ class DistributedFilter(JointFilter):
     targets share one random stream.
     """
 
-    resampling = ResamplingPolicy("multinomial", 1.0)
+    resampling = EVERY_STEP
 
     @property
     def loop(self) -> ParticleFilter:
@@ -233,12 +294,41 @@ class DistributedFilter(JointFilter):
         del state.targets[index]
 
     def step(self, state: DistributedState, z) -> None:
+        boxes = state.box_targets() if state.targets and self.resampling == EVERY_STEP else None
+        if boxes is not None:
+            return self.whole_frame(state, z, boxes)
         loop = self.loop
         state.t += 1
         weighed = [loop.weigh(target, z) for target in state.targets]
         final = self.interact([w.particles for w in weighed], [w.weights for w in weighed], state)
         for target, w, weights in zip(state.targets, weighed, final):
             loop.conclude(target, w.reweighted(weights))
+
+    def whole_frame(self, state: DistributedState, z, boxes: BoxTargets) -> None:
+        """:meth:`step` with every target's motion, likelihood, weights and resampling done for all targets
+        at once (:mod:`replication.filters.frame`): the loop's weigh of each target, the interaction, then
+        its conclude, with the same random draws in the same order and the same numbers."""
+        targets, n, rng = state.targets, self.n_particles, state.rng
+        m = len(targets)
+        state.t += 1
+        for target in targets:
+            target.t += 1
+        offsets = np.arange(m + 1) * n
+        moved = boxes.propagate(np.concatenate([target.particles for target in targets]), offsets, state.t, rng)
+        log_likelihood = boxes.log_likelihood(moved, offsets, z, state.t).reshape(m, n)
+        weights, log_totals, degenerate = normalise_rows(np.stack([target.log_weights for target in targets]), log_likelihood,
+                                                          corrected=True)
+        moved = moved.reshape(m, n, -1)
+        final = self.interact(list(moved), list(weights), state)
+        for target, particles, pi, log_total, flag in zip(targets, moved, final, log_totals, degenerate):
+            target.log_evidence += log_total
+            target.records.add(particles, pi, bool(flag))
+            target.records.resampled.append(True)
+        ancestors = inverse_cdf_rows(np.stack(final), rng.random((m, n)))  # each target's multinomial, in turn
+        resampled = gather_rows(moved, ancestors)
+        log_weights = np.full((m, n), -np.log(n))
+        for target, particles, uniform in zip(targets, resampled, log_weights):
+            target.particles, target.log_weights = particles, uniform
 
 
 @dataclass
@@ -301,5 +391,7 @@ class MRFJPF(JointFilter):
             degenerate = False
         except DegenerateWeightsError:
             weights, degenerate = np.full(n, 1.0 / n), True
+        with np.errstate(divide="ignore"):
+            log_weights = np.log(weights)
         for i, particles in enumerate(moved):
-            state.record(i, particles, weights, degenerate)
+            state.record(i, particles, weights, degenerate, log_weights)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from replication.compiled import matvec
 from replication.filters.bis import DistributedFilter, neighbours
 from replication.filters.joint import JointState
 
@@ -58,13 +59,34 @@ class DMOT(DistributedFilter):
         """The inertia factor of each particle; 1 until two estimates give a reference motion."""
         if len(means) < 2:
             return np.ones(len(particles))
-        last, reference = means[-1][:2], means[-1][:2] - means[-2][:2]
-        motion = particles[:, :2] - last
-        norms = np.linalg.norm(motion, axis=1) * np.linalg.norm(reference)
-        cosine = np.divide(motion @ reference, norms, out=np.ones(len(particles)), where=norms > 0)
-        theta = np.arccos(np.clip(cosine, -1.0, 1.0))
-        speed = np.linalg.norm(motion, axis=1) - np.linalg.norm(reference)
-        return 1.0 + np.exp(-(theta**2) / self.sigma_angle**2) * np.exp(-(speed**2) / self.sigma_speed**2) / self.alpha2
+        return _inertia(np.ascontiguousarray(particles, dtype=float), means[-1][:2], means[-1][:2] - means[-2][:2],
+                        self.sigma_angle**2, self.sigma_speed**2, float(self.alpha2))
+
+
+@njit(cache=True)
+def _inertia(particles, last, reference, angle_variance, speed_variance, alpha2):
+    """1 + exp(-theta^2 / sigma_angle^2) exp(-(|v| - |v_ref|)^2 / sigma_speed^2) / alpha2 per particle, v its
+    motion from ``last`` and theta its angle to ``reference`` (cos theta 1 where either has no length), in
+    numpy's operations: |v_ref| and v . v_ref by BLAS (:func:`~replication.compiled.matvec`), as
+    ``np.linalg.norm`` and ``@`` compute them, so the factors are the numpy form's to the bit."""
+    n = particles.shape[0]
+    motion = np.empty((n, 2))
+    for r in range(n):
+        motion[r, 0], motion[r, 1] = particles[r, 0] - last[0], particles[r, 1] - last[1]
+    reference_length = np.sqrt(np.dot(reference, reference))
+    along = matvec(motion, reference)
+    out = np.empty(n)
+    for r in range(n):
+        length = np.sqrt(motion[r, 0] * motion[r, 0] + motion[r, 1] * motion[r, 1])
+        norm = length * reference_length
+        cosine = along[r] / norm if norm > 0 else 1.0
+        if cosine < -1.0:
+            cosine = -1.0
+        elif cosine > 1.0:
+            cosine = 1.0
+        theta, speed = np.arccos(cosine), length - reference_length
+        out[r] = 1.0 + np.exp(-(theta * theta) / angle_variance) * np.exp(-(speed * speed) / speed_variance) / alpha2
+    return out
 
 
 @njit(cache=True)

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replication.filters.frame import BoxTargets, Targets
 from replication.smc.loop import FilterOutput, Summaries
 
 
@@ -22,11 +23,20 @@ class JointState:
 
     def __post_init__(self):
         self.records = [Summaries() for _ in self.models]
+        self.as_one = Targets()
 
-    def record(self, i: int, particles: np.ndarray, weights: np.ndarray, degenerate: bool) -> None:
-        """Store target i's weighted particles after a step (the next step resamples them)."""
-        with np.errstate(divide="ignore"):
-            self.particles[i], self.log_weights[i] = particles, np.log(weights)
+    def box_targets(self) -> BoxTargets | None:
+        """The models as one (:class:`~replication.filters.frame.BoxTargets`), or None."""
+        return self.as_one(self.models)
+
+    def record(self, i: int, particles: np.ndarray, weights: np.ndarray, degenerate: bool,
+               log_weights: np.ndarray | None = None) -> None:
+        """Store target i's weighted particles after a step (the next step resamples them); ``log_weights``,
+        log(weights), when the caller has them (weights every target shares)."""
+        if log_weights is None:
+            with np.errstate(divide="ignore"):
+                log_weights = np.log(weights)
+        self.particles[i], self.log_weights[i] = particles, log_weights
         self.records[i].add(particles, weights, degenerate)
         self.records[i].resampled.append(True)
 

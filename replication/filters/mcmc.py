@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from replication.filters.bis import neighbours
+from replication.filters.bis import _extents, _meeting
+from replication.filters.frame import BoxTargets
 from replication.filters.joint import JointFilter, JointState
 
 
@@ -127,11 +128,33 @@ class MCMCPF(JointFilter):
     def step(self, state: JointState, z) -> None:
         rng, m = state.rng, len(state.models)
         state.t += 1
-        carried = state.carried
         burn = int(self.burn_in * self.n_particles)
         total = burn + self.n_particles
         targets = rng.integers(m, size=total)
-        sources = rng.integers(len(carried[0]), size=total)
+        sources = rng.integers(len(state.carried[0]), size=total)
+        boxes = state.box_targets()
+        proposals, log_like, initial, initial_like, adjacent = (
+            self.propose(state, z, targets, sources) if boxes is None else self.propose_boxes(state, z, targets, sources, boxes))
+        accepted, score = _chain(targets, proposals, log_like, initial, initial_like, np.log(rng.random(total)), adjacent, self.beta)
+        held = _held(accepted, targets, m)
+        rows = np.concatenate([proposals, initial])
+        kept = rows[held[burn:].T]  # (M, N, d): each target's samples contiguous
+        # ties are rejected steps, whose joint states are the same; a stable sort orders them by step on
+        # every CPU (numpy's default sort is chosen by the CPU's vector extensions)
+        best = np.argsort(score[burn:], kind="stable")[-self.carry :]
+        weights = np.full(self.n_particles, 1.0 / self.n_particles)
+        with np.errstate(divide="ignore"):
+            log_weights = np.log(weights)
+        for i in range(m):
+            state.record(i, kept[i], weights, False, log_weights)
+        state.carried = [kept[i, best] for i in range(m)]
+
+    def propose(self, state: JointState, z, targets: np.ndarray, sources: np.ndarray) -> tuple:
+        """Every proposal of the chain, one pass per target (X'_i from carried sample r' by its model), the
+        chain's start (carried sample ``start`` moved by every motion), their log-likelihoods (with the
+        proposal's log p / q) and the MRF's edges among the targets' reachable states."""
+        rng, m, carried = state.rng, len(state.models), state.carried
+        total = len(targets)
         proposals = np.empty((total, carried[0].shape[1]))
         log_like = np.empty(total)
         chosen = [np.flatnonzero(targets == i) for i in range(m)]
@@ -145,15 +168,47 @@ class MCMCPF(JointFilter):
         for i, model in enumerate(state.models):  # the likelihoods of a target's proposals and start, one call
             scored = model.log_likelihood(reachable[i], z, state.t)
             log_like[chosen[i]], initial_like[i] = scored[:-1] + log_correction[chosen[i]], scored[-1]
-        adjacent = np.zeros((m, m), dtype=bool)
-        for i, j in neighbours(reachable):
-            adjacent[i, j] = adjacent[j, i] = True
-        accepted, score = _chain(targets, proposals, log_like, initial, initial_like, np.log(rng.random(total)), adjacent, self.beta)
-        held = _held(accepted, targets, m)
-        rows = np.concatenate([proposals, initial])
-        kept = rows[held[burn:].T]  # (M, N, d): each target's samples contiguous
-        best = np.argsort(score[burn:])[-self.carry :]
-        weights = np.full(self.n_particles, 1.0 / self.n_particles)
-        for i in range(m):
-            state.record(i, kept[i], weights, False)
-        state.carried = [kept[i, best] for i in range(m)]
+        return proposals, log_like, initial, initial_like, _adjacent(np.concatenate(reachable), np.cumsum([len(r) for r in reachable]))
+
+    def propose_boxes(self, state: JointState, z, targets: np.ndarray, sources: np.ndarray, boxes: BoxTargets) -> tuple:
+        """:meth:`propose` for box targets (:class:`~replication.filters.frame.BoxTargets`): every target's
+        proposals moved in one call, then every start, then all their likelihoods in one call, with the
+        same draws in the same order and the same numbers (a box model's log p / q is 0)."""
+        rng, m = state.rng, len(state.models)
+        order = np.argsort(targets, kind="stable")  # target after target, each in chain order: flatnonzero's
+        offsets = np.concatenate([[0], np.cumsum(np.bincount(targets, minlength=m))])
+        carried = np.stack(state.carried)
+        moved = boxes.propagate(carried[targets[order], sources[order]], offsets, state.t, rng)
+        start = int(rng.integers(carried.shape[1]))
+        initial = boxes.propagate(carried[:, start], np.arange(m + 1), state.t, rng)
+        reachable, ends = _with_starts(moved, offsets, initial)
+        scored = boxes.log_likelihood(reachable, np.concatenate([[0], ends]), z, state.t)
+        proposals, log_like = np.empty_like(moved), np.empty(len(targets))
+        proposals[order] = moved
+        log_like[order] = np.delete(scored, ends - 1) + 0.0
+        return proposals, log_like, initial, scored[ends - 1], _adjacent(reachable, ends)
+
+
+def _adjacent(reachable: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """adjacent[i, j]: whether targets i and j can overlap (their reachable states' clouds meet: the MRF's
+    edges), from the targets' rows stacked (target i's end before ``ends[i]``)."""
+    m = len(ends)
+    adjacent = np.zeros((m, m), dtype=bool)
+    for i, j in _meeting(*_extents(reachable, ends)):
+        adjacent[i, j] = adjacent[j, i] = True
+    return adjacent
+
+
+@njit(cache=True)
+def _with_starts(moved, offsets, initial):
+    """Each target's proposals (``moved`` rows ``offsets[i]:offsets[i + 1]``) followed by its start, stacked,
+    and where each target's rows end."""
+    m = initial.shape[0]
+    out = np.empty((moved.shape[0] + m, moved.shape[1]))
+    ends = np.empty(m, np.int64)
+    for i in range(m):
+        first = offsets[i] + i
+        out[first : first + offsets[i + 1] - offsets[i]] = moved[offsets[i] : offsets[i + 1]]
+        ends[i] = offsets[i + 1] + i + 1
+        out[ends[i] - 1] = initial[i]
+    return out, ends

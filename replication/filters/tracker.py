@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
+from replication.filters.frame import Targets, independent_frame
 from replication.filters.joint import JointFilter
 from replication.smc.loop import FilterOutput
 
@@ -97,11 +98,14 @@ class Independent(Tracker):
         for target, model in models.items():
             method = self.build()
             self.filters.append((method, method.start(model, streams(f"filter{target}"))))
+        self.as_one = Targets()
 
     def step(self, frame):
-        for method, state in self.filters:
-            method.step(state, frame)
-            state.model.adapt(state.records.means[-1], state.t)
+        boxes = self.as_one(self.models)  # box models with colour likelihoods: nothing to adapt
+        if boxes is None or not independent_frame([f for f, _ in self.filters], [s for _, s in self.filters], boxes, frame):
+            for method, state in self.filters:
+                method.step(state, frame)
+                state.model.adapt(state.records.means[-1], state.t)
         return [state.records.means[-1] for _, state in self.filters]
 
     def posterior(self, index):

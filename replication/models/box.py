@@ -115,9 +115,16 @@ class BoxModel:
         numbers in the same order.  One compiled pass (:func:`_moved`) gives ``constrain(f(x) + e @ W.T)``
         to the bit."""
         sources = self._sources
-        draws = rng.standard_normal((sources.blocks, len(particles), sources.width))
-        return _moved(particles, draws, sources.block, sources.column, sources.scale, self.kind == "constant_velocity",
-                      float(self.period), float(self.min_size))
+        draws = rng.standard_normal(sources.blocks * len(particles) * sources.width)  # C order: (blocks, N, width)
+        return self.moved(particles, draws, np.array([0, len(particles)]))
+
+    def moved(self, particles: np.ndarray, draws: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """:meth:`propagate` of the rows of targets of this motion (target t's ``offsets[t]:offsets[t + 1]``)
+        with their normals ``draws``, each target's (blocks, n_t, width) after the one before (:func:`_moved`)."""
+        sources = self._sources
+        return _moved(particles, draws, np.asarray(offsets, dtype=np.int64), sources.blocks, sources.width, sources.block,
+                      sources.column, sources.scale, self.kind == "constant_velocity", float(self.period),
+                      float(self.min_size))
 
     def propose(self, particles: np.ndarray, t: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | float]:
         """Draw x_t from the proposal given x_{t-1} = ``particles``, with log p(x_t | x_{t-1}) / q(x_t | ...),
@@ -180,22 +187,26 @@ class NoiseSources(NamedTuple):
 
 
 @njit(cache=True, error_model="numpy")
-def _moved(particles, draws, block, column, scale, constant_velocity, period, min_size):
+def _moved(particles, draws, offsets, blocks, width, block, column, scale, constant_velocity, period, min_size):
     """``constrain(f(x) + e @ W.T)`` in one pass: coordinate j of a particle is f_j(x) (x_j, plus v_j T for a
     constant-velocity centre) plus W_js e_s, its one noise term, and a size below ``min_size`` is raised to it.
+    The rows of one or more targets of one motion: target t's rows ``offsets[t]:offsets[t + 1]`` take its
+    normals, the next ``blocks`` x n_t x ``width`` of ``draws`` as one (blocks, n_t, width) block.
 
     Bit for bit the matrix form: each row of W has one non-zero entry, so (e W^T)_j is the rounded product
     W_js e_s whatever the order of the dot product (the other terms add exact zeros), added to f_j(x) as numpy
     adds it; the clamp keeps NaN, as ``np.maximum`` does."""
-    n, d = particles.shape
-    out = np.empty((n, d))
-    for i in range(n):
-        for j in range(d):
-            x = particles[i, j]
-            if constant_velocity and j < 2:
-                x = x + particles[i, j + 4] * period
-            x = x + draws[block[j], i, column[j]] * scale[j]
-            if (j == 2 or j == 3) and x < min_size:
-                x = min_size
-            out[i, j] = x
+    out = np.empty(particles.shape)
+    for t in range(offsets.size - 1):
+        first, rows = offsets[t], offsets[t + 1] - offsets[t]
+        for j in range(particles.shape[1]):  # a coordinate at a time: its noise term is one column of a block
+            noise = first * blocks * width + block[j] * rows * width + column[j]
+            for i in range(first, first + rows):
+                x = particles[i, j]
+                if constant_velocity and j < 2:
+                    x = x + particles[i, j + 4] * period
+                x = x + draws[noise + (i - first) * width] * scale[j]
+                if (j == 2 or j == 3) and x < min_size:
+                    x = min_size
+                out[i, j] = x
     return out

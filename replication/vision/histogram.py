@@ -39,6 +39,7 @@ import cv2
 import numpy as np
 from numba import njit, uint64
 
+from replication.compiled import pairwise_program, pairwise_sum
 from replication.vision.derived import derived
 
 KERNELS = ("epanechnikov", "diagonal", "uniform")
@@ -140,7 +141,7 @@ class ColourHistogram:
         u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
         self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
         self._runs = _pattern_runs(self.points, None if self.samples is not None else tuple(self.grid))
-        self._program = _pairwise_program(len(self.weights))  # numpy's order of a box's kernel-weight sum
+        self._program = pairwise_program(len(self.weights))  # numpy's order of a box's kernel-weight sum
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height."""
@@ -266,82 +267,11 @@ def _pattern_runs(points: np.ndarray, grid: tuple[int, int] | None):
             columns[starts].astype(np.int64), (columns[starts] + ends - starts).astype(np.int64), starts.astype(np.int64))
 
 
-def _pairwise_program(n: int) -> np.ndarray:
-    """numpy's order of summation of n values (pairwise: halves, cut at multiples of 8, down to
-    blocks of at most 128) as a postfix program of rows (start, size): a block to sum, or
-    (0, -1), add the last two sums.  Built once per pattern, so the compiled kernel needs no
-    recursion (a recursive function compiled with ``cache=True`` crashed numba when loaded back)."""
-    program = []
-
-    def visit(start, size):
-        if size <= 128:
-            program.append((start, size))
-            return
-        half = size // 2
-        half -= half % 8
-        visit(start, half)
-        visit(start + half, size - half)
-        program.append((0, -1))
-
-    visit(0, n)
-    return np.array(program, dtype=np.int64).reshape(-1, 2)
-
-
 @njit(cache=True)
 def _weight(weights, one_minus_v2, u2_minus_v2, share, k):
     """Sample k's kernel weight: the fixed kernel's (``share`` = -1), or the diagonal kernel's
     1 - v^2 - share (u^2 - v^2) with share = w^2 / (w^2 + h^2), as ``gather`` computes it."""
     return weights[k] if share < 0 else one_minus_v2[k] - share * u2_minus_v2[k]
-
-
-@njit(cache=True)
-def _block_sum(weights, one_minus_v2, u2_minus_v2, share, start, n):
-    """numpy's sum of at most 128 values: one by one under 8, else 8 running sums and a tail."""
-    if n < 8:
-        total = -0.0
-        for i in range(start, start + n):
-            total += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
-        return total
-    r0 = _weight(weights, one_minus_v2, u2_minus_v2, share, start)
-    r1 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 1)
-    r2 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 2)
-    r3 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 3)
-    r4 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 4)
-    r5 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 5)
-    r6 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 6)
-    r7 = _weight(weights, one_minus_v2, u2_minus_v2, share, start + 7)
-    i = start + 8
-    end = start + n - n % 8
-    while i < end:
-        r0 += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
-        r1 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 1)
-        r2 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 2)
-        r3 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 3)
-        r4 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 4)
-        r5 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 5)
-        r6 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 6)
-        r7 += _weight(weights, one_minus_v2, u2_minus_v2, share, i + 7)
-        i += 8
-    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < start + n:
-        total += _weight(weights, one_minus_v2, u2_minus_v2, share, i)
-        i += 1
-    return total
-
-
-@njit(cache=True)
-def _pairwise_sum(weights, one_minus_v2, u2_minus_v2, share, program, stack):
-    """The sum of a box's kernel weights in numpy's order (``program``, from
-    :func:`_pairwise_program`), so that it equals ``ndarray.sum`` of them to the last bit."""
-    depth = 0
-    for p in range(program.shape[0]):
-        if program[p, 1] < 0:
-            depth -= 1
-            stack[depth - 1] = stack[depth - 1] + stack[depth]
-        else:
-            stack[depth] = _block_sum(weights, one_minus_v2, u2_minus_v2, share, program[p, 0], program[p, 1])
-            depth += 1
-    return stack[0]
 
 
 @njit(cache=True)
@@ -459,8 +389,9 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
     takes that fast path; otherwise each of its boxes is read alone, its samples outside the
     image going to a spare bin.  Each bin gets its weights in the order of the samples, as
     ``np.bincount`` adds them, and the diagonal kernel's total is summed in numpy's order, so
-    the counts and totals are bit-identical to the numpy path's; only the touched bins are
-    square-rooted and reset.
+    the counts and totals are bit-identical to the numpy path's.  Only the bins of the reference
+    (q_u > 0) are square-rooted: another bin adds sqrt(c_u) 0, nothing, to rho; the group's
+    histograms are then reset at once.
     """
     height, width = image.shape
     flat = image.ravel()
@@ -471,7 +402,8 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
     row = np.empty((GROUP, vs.size), np.int64)
     share = np.full(GROUP, -1.0)  # the diagonal kernel's w^2 / (w^2 + h^2) per box; -1: a fixed kernel
     whole = np.full(GROUP, total_weight)  # the kernel's weight over all the samples of each box
-    stack = np.empty(64)
+    diagonal_weights = np.empty(weights.size)
+    support = np.flatnonzero(root != 0.0)  # the reference's bins, in order
     G = uint64(GROUP)
     source = _same_pattern(boxes, us, vs, width, height)
     todo = np.flatnonzero(source == np.arange(n))  # one box of each pattern
@@ -484,7 +416,9 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
                 fast = False
             if diagonal:  # r^2 = (u^2 hx^2 + v^2 hy^2) / (hx^2 + hy^2): fusion_pf eq (2)
                 share[g] = boxes[b, 2] ** 2 / (boxes[b, 2] ** 2 + boxes[b, 3] ** 2)
-                whole[g] = _pairwise_sum(weights, one_minus_v2, u2_minus_v2, share[g], program, stack)
+                for k in range(weights.size):
+                    diagonal_weights[k] = _weight(weights, one_minus_v2, u2_minus_v2, share[g], k)
+                whole[g] = pairwise_sum(diagonal_weights, program)
         if fast and not diagonal:
             for r in range(rows.size):
                 j = rows[r]
@@ -533,25 +467,26 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
                             hist[spare + g] += w
                         else:
                             hist[np.int64(flat[y + x]) * GROUP + g] += w
-        acc = np.zeros(GROUP)  # each box's sum of sqrt(c_u) sqrt(q_u)
-        for u in range(n_bins):  # the group's bins in one pass: a bin is one cache line of its 8 boxes' counts
-            h = u * GROUP
-            either = ((hist[h] + hist[h + 1]) + (hist[h + 2] + hist[h + 3])) + ((hist[h + 4] + hist[h + 5]) + (hist[h + 6] + hist[h + 7]))
-            if either != 0.0:  # the weights are positive (or NaN): a zero sum is eight empty counts
-                for g in range(m):
-                    count = hist[h + g]
-                    if count != 0.0:
-                        acc[g] += np.sqrt(count) * root[u]
-                        hist[h + g] = 0.0
+        acc = np.zeros(GROUP)  # each box's sum of sqrt(c_u) sqrt(q_u), bin after bin
+        for k in range(support.size):  # a bin is one cache line of its 8 boxes' counts
+            u = support[k]
+            for g in range(m):
+                count = hist[u * GROUP + g]
+                if count != 0.0:
+                    acc[g] += np.sqrt(count) * root[u]
         for g in range(m):
             outside = hist[n_bins * GROUP + g]
             total = whole[g] - outside  # all the kernel's weight but the points outside the image
-            hist[n_bins * GROUP + g] = 0.0
             if total <= 1e-9 * whole[g]:  # nothing inside, up to rounding
                 total = 0.0
-            s = np.nan if np.isnan(outside) else acc[g]  # a NaN weight outside (zero-size diagonal box): NaN, as numpy's dot
+            s = acc[g]
+            if np.isnan(outside):  # a NaN weight outside (a zero-size diagonal-kernel box): NaN, as numpy's dot
+                s = np.nan
+            elif np.isnan(share[g]):  # every weight of such a box is that NaN, as are its counts
+                s = share[g]
             rho[todo[start + g]] = s / np.sqrt(total if total > 0 else 1.0)
             valid[todo[start + g]] = total > 0
+        hist[:] = 0.0
     for b in range(n):  # a box on another's pixels has its histogram
         rho[b], valid[b] = rho[source[b]], valid[source[b]]
     return rho, valid
