@@ -1,7 +1,18 @@
 """The project's numba conventions: scalar functions compiled into numpy ufuncs, and, for compiled kernels
-that must give numpy's bits, numpy's own order of a sum and its BLAS calls."""
+that must give numpy's bits, numpy's own order of a sum and its BLAS calls.
 
-from functools import lru_cache
+A sum's rounding depends on the order of its additions.  BLAS (``np.dot``, ``@``) picks its order by the
+CPU it finds (OpenBLAS's Haswell, SkylakeX and Sandybridge kernels each split a dot product into other
+partial sums) and by its thread count, so a weighted mean or an ESS computed with it differs in the last
+digits between an AVX2 and an AVX-512 machine, or between one BLAS thread and two.  ``np.sum`` does not:
+its pairwise summation (numpy's ``pairwise_sum``, ``loops_utils.h.src``) fixes the order from N alone,
+blocks of at most 128 terms summed by eight accumulators and halved at multiples of 8, whatever SIMD width
+the CPU has.  :func:`pairwise_sum` is that order, bit for bit (``np.sum(values)``); a kernel that makes
+its terms as it goes (:mod:`replication.smc.weights`) walks the same tree (:func:`half`) and sums each
+leaf of at most :data:`BLOCK` terms with :func:`block_sum`, so a weighted sum costs one pass with no
+temporary array.  Numba compiles it without fast-math, so no CPU's code reassociates the additions or
+fuses a product into them.  (Recursive kernels load back from numba's cache: checked across modules.)
+"""
 
 import numpy as np
 from numba import njit, vectorize
@@ -14,44 +25,23 @@ def elementwise(signature: str):
     return lambda function: vectorize([signature], cache=True)(function).ufunc
 
 
-@lru_cache(maxsize=64)
-def pairwise_program(n: int) -> np.ndarray:
-    """numpy's order of summation of n contiguous values (``ndarray.sum``: pairwise, halves cut at
-    multiples of 8, down to blocks of at most 128) as a postfix program of rows (start, size): a block
-    to sum, or (0, -1), add the last two sums.  Built once per n, so that :func:`pairwise_sum` needs no
-    recursion (a recursive function compiled with ``cache=True`` crashed numba when loaded back).
-    Read-only: one array serves every caller."""
-    program = []
-
-    def visit(start, size):
-        if size <= 128:
-            program.append((start, size))
-            return
-        half = size // 2
-        half -= half % 8
-        visit(start, half)
-        visit(start + half, size - half)
-        program.append((0, -1))
-
-    visit(0, n)
-    made = np.array(program, dtype=np.int64).reshape(-1, 2)
-    made.flags.writeable = False
-    return made
+BLOCK = 128  # numpy's PW_BLOCKSIZE: a leaf of the pairwise tree
 
 
 @njit(cache=True)
-def _block_sum(values, start, n):
-    """numpy's sum of at most 128 values: one by one under 8, else 8 running sums and a tail."""
+def block_sum(values):
+    """Numpy's sum of at most :data:`BLOCK` numbers: in order below 8, else eight running sums over the whole
+    eights, combined as ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)), then the rest in order."""
+    n = values.size
     if n < 8:
         total = -0.0
-        for i in range(start, start + n):
+        for i in range(n):
             total += values[i]
         return total
-    r0, r1, r2, r3 = values[start], values[start + 1], values[start + 2], values[start + 3]
-    r4, r5, r6, r7 = values[start + 4], values[start + 5], values[start + 6], values[start + 7]
-    i = start + 8
-    end = start + n - n % 8
-    while i < end:
+    r0, r1, r2, r3 = values[0], values[1], values[2], values[3]
+    r4, r5, r6, r7 = values[4], values[5], values[6], values[7]
+    whole = n - n % 8
+    for i in range(8, whole, 8):
         r0 += values[i]
         r1 += values[i + 1]
         r2 += values[i + 2]
@@ -60,28 +50,31 @@ def _block_sum(values, start, n):
         r5 += values[i + 5]
         r6 += values[i + 6]
         r7 += values[i + 7]
-        i += 8
     total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < start + n:
+    for i in range(whole, n):
         total += values[i]
-        i += 1
     return total
 
 
 @njit(cache=True)
-def pairwise_sum(values, program):
-    """``values.sum()`` of a 1-D array in numpy's order (``program``: :func:`pairwise_program` of its
-    length), to the last bit."""
-    stack = np.empty(64)
-    depth = 0
-    for p in range(program.shape[0]):
-        if program[p, 1] < 0:
-            depth -= 1
-            stack[depth - 1] = stack[depth - 1] + stack[depth]
-        else:
-            stack[depth] = _block_sum(values, program[p, 0], program[p, 1])
-            depth += 1
-    return stack[0]
+def half(n):
+    """Where numpy splits n > :data:`BLOCK` terms: n // 2 rounded down to a multiple of 8."""
+    h = n // 2
+    return h - h % 8
+
+
+@njit(cache=True)
+def _tree(values):
+    if values.size <= BLOCK:
+        return block_sum(values)
+    h = half(values.size)
+    return _tree(values[:h]) + _tree(values[h:])
+
+
+@njit(cache=True)
+def pairwise_sum(values):
+    """``np.sum(values)`` of a 1-D float64 array, bit for bit: numpy adds the tree's sum to its identity 0.0."""
+    return 0.0 + _tree(values)
 
 
 @njit(cache=True)

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from replication.vision.colour import ColourLikelihood
-from replication.compiled import pairwise_program, pairwise_sum
 from replication.vision.histogram import KERNELS, ColourHistogram, hsv_bin_image
 from replication.vision.likelihood import gaussian_similarity_log_likelihood
 
@@ -68,15 +67,6 @@ def test_a_group_of_boxes_inside_and_one_outside_agree():
     rho_numpy, valid_numpy = histogram.bhattacharyya_numpy(bin_image, boxes, reference)
     assert rho[0] == pytest.approx(1.0) and valid.all() and valid_numpy.all()
     np.testing.assert_allclose(rho, rho_numpy, rtol=0, atol=1e-13)
-
-
-def test_the_pairwise_sum_is_numpys_sum_to_the_bit():
-    """The kernel's diagonal totals and the compiled normalisations sum as ndarray.sum does."""
-    rng = np.random.default_rng(0)
-    for n in [1, 7, 8, 9, 127, 128, 129, 255, 256, 400, 1000, 1600, 4097, 12000]:
-        values = rng.random(n) * np.exp(rng.normal(0, 20, n))
-        assert pairwise_sum(values, pairwise_program(n)) == values.sum()
-    assert np.signbit(pairwise_sum(np.array([-0.0]), pairwise_program(1))) == np.signbit(np.array([-0.0]).sum())
 
 
 @pytest.mark.parametrize("kernel", KERNELS)

@@ -79,7 +79,7 @@ SIZES = [*range(0, 300), 1000, 4097, 8192, 8193, 100_007]
 def test_pairwise_sum_is_numpys_sum_bit_for_bit():
     """The compiled tree is numpy's pairwise order (blocks of 128, eight accumulators, halves at multiples
     of 8), whose result depends on N alone: the same on every CPU, unlike BLAS's dot."""
-    from replication.smc.pairwise import pairwise_sum
+    from replication.compiled import pairwise_sum
 
     rng = np.random.default_rng(1)
     for n in SIZES:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from replication.compiled import pairwise_program, pairwise_sum
+from replication.compiled import pairwise_sum
 from replication.smc.loop import (
     FilterOutput,
     FilterState,
@@ -133,7 +133,7 @@ def bootstrap_histograms(particles: list, pi: list, k: int, beta: float, rng: np
         n = len(pi[0])
         draws = inverse_cdf_rows(np.stack(pi), rng.random((len(pi), k)))  # B_i(k), eq (5): one pass for all targets
         log_w = _draw_log_potential(np.stack(particles).astype(float, copy=False), draws, pairs, float(beta))
-        return list(_marginals(draws, log_w, n, pairwise_program(n)))
+        return list(_marginals(draws, log_w, n))
     draws = np.stack([multinomial(p, rng, size=k) for p in pi])  # targets with different N: the numpy form
     log_w = pairwise_log_potential([p[d] for p, d in zip(particles, draws)], beta, [tuple(q) for q in pairs])
     w = np.exp(log_w - log_w.max())
@@ -195,16 +195,16 @@ def _draw_log_potential(states, draws, pairs, beta):
 
 
 @njit(cache=True)
-def _marginals(draws, log_w, n, program):
+def _marginals(draws, log_w, n):
     """W_i (M, n) from the draws and their log MRF weights: ``w = exp(log_w - max)``, each target's
-    :func:`_tally`, divided by its sum (numpy's order: ``program``)."""
+    :func:`_tally`, divided by its sum (numpy's order)."""
     top = log_w.max() if not np.isnan(log_w).any() else np.nan
     w = np.empty(log_w.size)
     for k in range(log_w.size):
         w[k] = np.exp(log_w[k] - top)
     out = _tally(draws, w, n)
     for i in range(out.shape[0]):
-        total = pairwise_sum(out[i], program)
+        total = pairwise_sum(out[i])
         for u in range(n):
             out[i, u] = out[i, u] / total
     return out

@@ -15,12 +15,11 @@ other model (a proposal fusing detections, a fused likelihood).
 import numpy as np
 from numba import njit
 
-from replication.compiled import pairwise_program, pairwise_sum
 from replication.errors import NotFinite
 from replication.models.box import BoxModel
 from replication.smc.loop import ParticleFilter, prior_proposal
 from replication.smc.resampling import inverse_cdf_rows
-from replication.smc.weights import DegenerateWeightsError
+from replication.smc.weights import DegenerateWeightsError, exp_sum
 from replication.smc.work import Counted
 from replication.vision.joint import ColourLikelihoods
 
@@ -143,8 +142,7 @@ def normalise_rows(log_weights: np.ndarray, log_likelihood: np.ndarray, correcte
     (weights, log-sums, degenerate).  Raises what :func:`~replication.smc.weights.normalise` raises where
     even that fails."""
     weights, log_totals, degenerate = np.empty_like(log_weights), np.empty(len(log_weights)), np.zeros(len(log_weights), bool)
-    refuse(_normalise_rows(log_weights, log_likelihood, corrected, pairwise_program(log_weights.shape[1]), weights,
-                           log_totals, degenerate))
+    refuse(_normalise_rows(log_weights, log_likelihood, corrected, weights, log_totals, degenerate))
     return weights, log_totals, degenerate
 
 
@@ -160,18 +158,18 @@ def refuse(status: int) -> None:
 
 
 @njit(cache=True)
-def _normalise_rows(log_weights, log_likelihood, corrected, program, weights, log_totals, degenerate):
+def _normalise_rows(log_weights, log_likelihood, corrected, weights, log_totals, degenerate):
     """Into ``weights`` etc. row by row; stops at a row it cannot weight, returning why (else 0)."""
     for i in range(log_weights.shape[0]):
         row = weights[i]
         for k in range(row.size):
             row[k] = _predicted(log_weights[i, k], corrected) + log_likelihood[i, k]
-        status, log_totals[i] = normalise_in_place(row, program)
+        status, log_totals[i] = normalise_in_place(row)
         if status == DEGENERATE:  # no particle explains the frame: keep the predicted weights
             degenerate[i] = True
             for k in range(row.size):
                 row[k] = _predicted(log_weights[i, k], corrected)
-            status, log_totals[i] = normalise_in_place(row, program)
+            status, log_totals[i] = normalise_in_place(row)
         if status:
             return status
     return 0
@@ -183,18 +181,16 @@ def _predicted(log_weight, corrected):
 
 
 @njit(cache=True)
-def normalise_in_place(row, program):
+def normalise_in_place(row):
     """:func:`~replication.smc.weights.normalise` of ``row`` into it, in its operations and order (exp of the
-    differences from the maximum, numpy's pairwise sum: ``program``, then the division): (0, log of the
+    differences from the maximum summed in numpy's order as they are made: ``exp_sum``, then the division): (0, log of the
     sum), or (NOT_FINITE, NaN) on a NaN or +inf and (DEGENERATE, NaN) when every entry is -inf."""
     top = _top(row)
     if np.isnan(top) or top == np.inf:
         return NOT_FINITE, np.nan
     if top == -np.inf:
         return DEGENERATE, np.nan
-    for k in range(row.size):
-        row[k] = np.exp(row[k] - top)
-    total = pairwise_sum(row, program)
+    total = exp_sum(row, top, row)
     for k in range(row.size):
         row[k] = row[k] / total
     return 0, top + np.log(total)

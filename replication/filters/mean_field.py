@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from numba.typed import List
 
-from replication.compiled import matvec, pairwise_program
+from replication.compiled import matvec
 from replication.filters.bis import DistributedFilter, _meeting, cloud_extents, log_potential_table
 from replication.filters.frame import normalise_in_place, refuse
 from replication.filters.joint import JointState
@@ -38,13 +38,13 @@ class MFMC(DistributedFilter):
         low, high = cloud_extents(particles)
         pairs = np.array(_meeting(low, high), dtype=np.int64).reshape(-1, 2)
         q, status = _mean_field(np.stack(particles).astype(float, copy=False), np.stack(pi), low, high, pairs,
-                                float(self.beta), int(self.iterations), pairwise_program(len(pi[0])))
+                                float(self.beta), int(self.iterations))
         refuse(status)
         return list(q)
 
 
 @njit(cache=True, error_model="numpy")
-def _mean_field(states, pi, low, high, pairs, beta, iterations, program):
+def _mean_field(states, pi, low, high, pairs, beta, iterations):
     """The fixed-point iterations for M targets of N particles (``states`` (M, N, d), ``pi`` (M, N)) and the
     neighbouring ``pairs``: (q (M, N), 0), or NOT_FINITE / DEGENERATE where a q_i cannot be normalised.
 
@@ -78,7 +78,7 @@ def _mean_field(states, pi, low, high, pairs, beta, iterations, program):
         for i in range(m):
             for k in range(n):
                 q[i, k] = log_pi[i, k] + field[i, k]
-            status, _ = normalise_in_place(q[i], program)
+            status, _ = normalise_in_place(q[i])
             if status:
                 return q, status
     return q, 0

@@ -24,7 +24,7 @@ from numba import njit
 
 from replication.libm import exp, log
 from replication.models.additive import AdditiveGaussianModel
-from replication.smc.pairwise import BLOCK, block_sum, half
+from replication.compiled import BLOCK, block_sum, half
 from replication.smc.weights import moments
 
 

@@ -1,6 +1,6 @@
 """Importance weights kept as log-weights, and the estimators built on them.
 
-Every sum here is numpy's pairwise sum (:mod:`replication.smc.pairwise`), fused into the compiled pass
+Every sum here is numpy's pairwise sum (:mod:`replication.compiled`), fused into the compiled pass
 that makes its terms, and every exponential and logarithm is the C library's (``math.exp``, ``math.log``):
 a step's weights, ESS and weighted moments are then the same numbers on every CPU, with any number of BLAS
 threads (see docs/reproducibility.md, "Weights that round alike"), and a step calls no BLAS.
@@ -13,7 +13,7 @@ from numba import njit
 
 from replication.errors import NotFinite
 from replication.libm import exp, log
-from replication.smc.pairwise import BLOCK, block_sum, half
+from replication.compiled import BLOCK, block_sum, half
 
 
 class DegenerateWeightsError(ValueError):
@@ -44,9 +44,15 @@ def normalise(log_weights: np.ndarray, out: np.ndarray | None = None) -> tuple[n
     if top == -math.inf:
         raise DegenerateWeightsError("every log-weight is -inf")
     weights = np.empty(log_weights.shape) if out is None else out
-    total = 0.0 + _exp_tree(np.ascontiguousarray(log_weights).reshape(-1), top, weights.reshape(-1))
+    total = exp_sum(np.ascontiguousarray(log_weights).reshape(-1), top, weights.reshape(-1))
     weights /= total
     return weights, top + math.log(total)
+
+
+@njit(cache=True, error_model="numpy")
+def exp_sum(log_weights, top, out):
+    """out_i = exp(lw_i - top) in one pass (``out`` may be ``log_weights``), and ``np.sum(out)``."""
+    return 0.0 + _exp_tree(log_weights, top, out)
 
 
 @njit(cache=True, error_model="numpy")

@@ -39,7 +39,7 @@ import cv2
 import numpy as np
 from numba import njit, uint64
 
-from replication.compiled import pairwise_program, pairwise_sum
+from replication.compiled import pairwise_sum
 from replication.vision.derived import derived
 
 KERNELS = ("epanechnikov", "diagonal", "uniform")
@@ -141,7 +141,6 @@ class ColourHistogram:
         u2, v2 = self.points[:, 0] ** 2, self.points[:, 1] ** 2  # the diagonal kernel is 1 - v^2 - share (u^2 - v^2)
         self._one_minus_v2, self._u2_minus_v2 = (1.0 - v2)[None, :], (u2 - v2)[None, :]
         self._runs = _pattern_runs(self.points, None if self.samples is not None else tuple(self.grid))
-        self._program = pairwise_program(len(self.weights))  # numpy's order of a box's kernel-weight sum
 
     def of_boxes(self, bin_image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """Normalised histograms (N, B) of ``boxes`` (N, 4) as centre x, centre y, width, height."""
@@ -167,7 +166,7 @@ class ColourHistogram:
         return _bhattacharyya_kernel(
             image, boxes, us, vs, rows, first_column, last_column, first_sample, self.weights,
             self._one_minus_v2[0], self._u2_minus_v2[0], self.kernel == "diagonal", self._total_weight,
-            self._program, np.sqrt(np.asarray(reference, dtype=float)[: self.n_bins]),
+            np.sqrt(np.asarray(reference, dtype=float)[: self.n_bins]),
         )
 
     def bhattacharyya_numpy(self, bin_image: np.ndarray, boxes: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -379,7 +378,7 @@ def _cell(corner, beta, reach):
 
 @njit(cache=True, error_model="numpy")  # IEEE division: a zero-size diagonal-kernel box gives NaN, as numpy does
 def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column, first_sample, weights,
-                          one_minus_v2, u2_minus_v2, diagonal, total_weight, program, root):
+                          one_minus_v2, u2_minus_v2, diagonal, total_weight, root):
     """rho and validity of every box: :meth:`ColourHistogram.bhattacharyya` in one pass per box.
 
     Boxes are read ``GROUP`` (8) at a time, side by side, each into its own histogram,
@@ -418,7 +417,7 @@ def _bhattacharyya_kernel(image, boxes, us, vs, rows, first_column, last_column,
                 share[g] = boxes[b, 2] ** 2 / (boxes[b, 2] ** 2 + boxes[b, 3] ** 2)
                 for k in range(weights.size):
                     diagonal_weights[k] = _weight(weights, one_minus_v2, u2_minus_v2, share[g], k)
-                whole[g] = pairwise_sum(diagonal_weights, program)
+                whole[g] = pairwise_sum(diagonal_weights)
         if fast and not diagonal:
             for r in range(rows.size):
                 j = rows[r]

@@ -54,7 +54,7 @@ class ColourLikelihoods:
         return _log_likelihoods(
             image, np.ascontiguousarray(boxes[:, :4], dtype=float), np.asarray(offsets, dtype=np.int64), us, vs, rows,
             first_column, last_column, first_sample, histogram.weights, histogram._one_minus_v2[0],
-            histogram._u2_minus_v2[0], histogram.kernel == "diagonal", histogram._total_weight, histogram._program,
+            histogram._u2_minus_v2[0], histogram.kernel == "diagonal", histogram._total_weight,
             self.roots, self.two_variance, self.log_norm,
         )
 
@@ -66,7 +66,7 @@ def _same_pattern(histogram: ColourHistogram, other: ColourHistogram) -> bool:
 
 @njit(cache=True, error_model="numpy")
 def _log_likelihoods(image, boxes, offsets, us, vs, rows, first_column, last_column, first_sample, weights,
-                     one_minus_v2, u2_minus_v2, diagonal, total_weight, program, roots, two_variance, log_norm):
+                     one_minus_v2, u2_minus_v2, diagonal, total_weight, roots, two_variance, log_norm):
     """Target after target, rho of its boxes (the kernel) and -(1 - rho) / (2 sigma^2) - log(sqrt(2 pi)
     sigma), or -inf for a box with no sample in the image or no area (ColourLikelihood.similarity)."""
     out = np.empty(boxes.shape[0])
@@ -74,7 +74,7 @@ def _log_likelihoods(image, boxes, offsets, us, vs, rows, first_column, last_col
         first, last = offsets[i], offsets[i + 1]
         rho, inside = _bhattacharyya_kernel(image, boxes[first:last], us, vs, rows, first_column, last_column,
                                             first_sample, weights, one_minus_v2, u2_minus_v2, diagonal, total_weight,
-                                            program, roots[i])
+                                            roots[i])
         for r in range(last - first):
             box = boxes[first + r]
             if inside[r] and box[2] > 0 and box[3] > 0:
