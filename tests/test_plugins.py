@@ -47,10 +47,10 @@ def installed(tmp_path, monkeypatch):
         (info / "entry_points.txt").write_text(
             f"[{registry.GROUP}]\n" + "".join(f"{name} = {value}\n" for name, value in points.items()))
         monkeypatch.syspath_prepend(str(info.parent))
-        registry.registered.cache_clear()
+        registry.FILTERS.forget()
 
     yield install
-    registry.registered.cache_clear()
+    registry.FILTERS.forget()
 
 
 def test_the_built_ins_come_in_by_the_entry_points_this_package_declares():

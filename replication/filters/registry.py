@@ -11,20 +11,19 @@ Everything that can go wrong in finding or building one is one :class:`~replicat
 line naming the filter.
 """
 
-import functools
 import importlib
 import importlib.metadata
 from collections.abc import Callable
 from typing import Any
 
 from replication.errors import ConfigError
+from replication.kinds import Registry
 
 GROUP = "replication.filters"
 RESERVED = ("filter", "label")  # a method's keys that are not its builder's parameters
 
 
-@functools.cache
-def registered() -> dict[str, importlib.metadata.EntryPoint]:
+def _entry_points():
     """Every entry point of :data:`GROUP`, by name; two distributions registering one name is an error."""
     found: dict[str, importlib.metadata.EntryPoint] = {}
     for point in importlib.metadata.entry_points(group=GROUP):
@@ -35,23 +34,24 @@ def registered() -> dict[str, importlib.metadata.EntryPoint]:
     if not found:
         raise ConfigError(f"no filter is registered under {GROUP}: install this package (make setup, or "
                           "pip install -e .)")
-    return found
+    return found.items()
+
+
+FILTERS: Registry[importlib.metadata.EntryPoint] = Registry("filter", load=_entry_points,
+                                                            hint=" (or an import path, module:name)")
 
 
 def builder(name: str) -> Callable:
     """The builder ``name`` names: an import path ``module:attribute`` or a registered entry point."""
     if not isinstance(name, str) or not name:
         raise ConfigError(f"filter must name a builder (a registered name or module:name), got {name!r}")
-    if ":" not in name and name not in registered():
-        raise ConfigError(f"unknown filter {name!r}; known filters: {', '.join(sorted(registered()))} "
-                          "(or an import path, module:name)")
-    module, _, attribute = (name if ":" in name else registered()[name].value).partition(":")
+    module, _, attribute = (name if ":" in name else FILTERS[name].value).partition(":")
     return _callable(name, _attribute(name, _module(name, module), attribute))
 
 
 def builders() -> dict[str, Callable]:
     """Every registered builder, by name."""
-    return {name: builder(name) for name in sorted(registered())}
+    return {name: builder(name) for name in sorted(FILTERS)}
 
 
 def build_filter(method: str, params: dict[str, Any], condition: str = ""):

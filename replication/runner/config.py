@@ -88,9 +88,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     """
     exp = cfg.experiment
     repetitions = n_runs(cfg)
-    if exp.get("task") not in TASKS:
-        raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
-    task = TASKS[exp.task]
+    task = TASKS[exp.get("task")]
     experiment = experiment_at_scale(cfg)
     scenes = experiment.get("scenes", {})
     runs, skipped = [], [] if skipped is None else skipped

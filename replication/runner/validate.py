@@ -109,26 +109,33 @@ def _type_mismatch(value: typing.Any, declared: typing.Any) -> str | None:
 
 
 def check_scenes(cfg: DictConfig) -> None:
-    """An OTB scene names its sequence, and a ``root:`` given for it exists.
+    """Every scene is of a known kind, and a real one names its sequence and exists at a ``root:`` given.
 
-    (A sequence absent from the shared OTB folder is not an error: its
+    (A sequence absent from the shared folder is not an error: its
     conditions are skipped, so the suite runs on machines without the data.)
     """
-    from replication.scenes.otb import OTB_ROOT
+    from replication.scenes.factory import scene_kind
 
     if not isinstance(cfg.experiment.get("scenes"), DictConfig):
         return
     scenes = at_scale(OmegaConf.to_container(cfg.experiment.scenes, resolve=True), cfg.scale)
     for name, spec in scenes.items():
-        if not isinstance(spec, dict) or spec.get("kind") != "otb":
+        if not isinstance(spec, dict):
+            continue
+        try:
+            kind = scene_kind(spec)
+        except ConfigError as error:
+            raise ConfigError(f"experiment.scenes.{name}.kind: {error}") from None
+        if not kind.real:
             continue
         if not isinstance(spec.get("name"), str) or not spec["name"]:
-            raise ConfigError(f"experiment.scenes.{name}.name: an OTB scene names its sequence (e.g. name: Girl)")
+            raise ConfigError(f"experiment.scenes.{name}.name: a scene of kind {kind.name} names its "
+                              f"{kind.benchmark} sequence")
         if "root" in spec:
             root = resolve(str(spec["root"]))
             if not root.is_dir():
                 raise ConfigError(
-                    f"experiment.scenes.{name}.root: no folder {root} (leave root out for the shared {OTB_ROOT})"
+                    f"experiment.scenes.{name}.root: no folder {root} (leave root out for the shared {kind.root})"
                 )
 
 

@@ -26,7 +26,7 @@ from replication.metrics.mot import BOX
 from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
 from replication.run import Run
-from replication.scenes.factory import cached_sequence
+from replication.scenes.factory import cached_sequence, scene_kind
 from replication.smc.work import Counted, Work
 from replication.vision.colour import ColourLikelihood
 from replication.vision.fusion import FusionLikelihood
@@ -57,6 +57,9 @@ def scene_spec(run: Run) -> dict:
 def check(model: dict, method: dict) -> None:
     if "scene_spec" not in model:
         raise ValueError("a tracking experiment needs model.scene naming one of experiment.scenes")
+    if scene_kind(model["scene_spec"]).open_set:
+        raise ValueError("a tracking experiment follows a fixed set of targets; a scene whose people come and go "
+                         "is the mot task's")
     if model["scene_spec"].get("scene_seed", "fixed") not in SCENE_SEEDS:
         raise ValueError(f"unknown scene_seed {model['scene_spec']['scene_seed']!r}; choose one of {SCENE_SEEDS}")
     observation = model.get("observation", {})
