@@ -14,7 +14,9 @@ top-level name, ``from replication import bootstrap, kalman_filter, VideoSequenc
   to step one or many targets through frames;
 * models (:mod:`replication.models`): :class:`LinearGaussian` with its exact
   :func:`kalman_filter`, :class:`UNGM`, :class:`AdditiveGaussianModel` to derive
-  your own scalar model from, :class:`BoxModel` for a target's box in video;
+  your own scalar model from, :class:`BoxModel` for a target's box in video, and the one
+  conversion of a box between its corner (x, y, w, h) and centre (cx, cy, w, h) forms
+  (:func:`centre_boxes`, :func:`corner_boxes`, :func:`centres`);
 * observation models (:mod:`replication.vision`): :class:`ColourHistogram`,
   :class:`ColourLikelihood`, :class:`FusionLikelihood`, the Bhattacharyya coefficient;
 * metrics (:mod:`replication.metrics`): OTB precision and success, CLEAR MOT,
@@ -57,6 +59,7 @@ _EXPORTS = {  # module: the public names it defines, in the order of the API ref
     "replication.models.ungm": ("UNGM",),
     "replication.models.point_mass": ("point_mass_filter",),
     "replication.models.box": ("BoxModel",),
+    "replication.boxes": ("centres", "centre_boxes", "corner_boxes"),
     "replication.models.boosted": ("BoostedBoxModel",),
     "replication.vision.histogram": ("ColourHistogram", "hsv_bin_image"),
     "replication.vision.colour": ("ColourLikelihood",),

@@ -20,6 +20,8 @@ GOT-10k's own evaluation (``ExperimentGOT10k.report``) leaves it out.
 
 import numpy as np
 
+from replication.boxes import centres
+
 PRECISION_THRESHOLDS = np.arange(0, 51)
 SUCCESS_THRESHOLDS = np.linspace(0.0, 1.0, 21)
 # The OTB scores count the first frame, whose box is the given truth, as OTB's toolkit does (hspf
@@ -30,11 +32,6 @@ COUNT_FIRST_FRAME = True
 def scored_frames(per_frame: np.ndarray, count_first_frame: bool = COUNT_FIRST_FRAME) -> np.ndarray:
     """The frames (first axis) of a one-pass run that the OTB scores count; see :data:`COUNT_FIRST_FRAME`."""
     return np.asarray(per_frame)[0 if count_first_frame else 1 :]
-
-
-def centres(boxes: np.ndarray) -> np.ndarray:
-    boxes = np.asarray(boxes, dtype=float)
-    return boxes[..., :2] + boxes[..., 2:4] / 2.0
 
 
 def outside_image(boxes: np.ndarray, size) -> np.ndarray:

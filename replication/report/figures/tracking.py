@@ -8,10 +8,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import to_rgb
 
+from replication.boxes import centres
 from replication.evidence.aggregate import scene_of, sequence_seen
 from replication.evidence.attributes import absent, attribute_scores
 from replication.metrics import multi
-from replication.metrics.tracking import centres
 from replication.report.figures.style import (
     NothingToDraw, axis_label, clipped_note, method_label, method_look, save,
 )
@@ -161,9 +161,9 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         axis = "xy".index(run["strip"]["axis"])
         ax.imshow(density.T, origin="lower", aspect="auto", cmap="magma",
                   extent=(1, density.shape[0], 0, sequence.size[axis]))
-        centres = sequence.truth[1:, :, axis] + sequence.truth[1:, :, axis + 2] / 2
-        for m in range(centres.shape[1]):
-            ax.plot(np.arange(1, len(centres) + 1), centres[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
+        truth = centres(sequence.truth[1:])[..., axis]
+        for m in range(truth.shape[1]):
+            ax.plot(np.arange(1, len(truth) + 1), truth[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
         first, last = spec.get("window", (None, None))
         if first is not None:
             ax.axvspan(first, last, color="w", alpha=0.08)
