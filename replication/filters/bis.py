@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from replication.filters.registry import drawn
 from replication.smc.loop import (
     FilterOutput,
     FilterState,
@@ -241,6 +242,7 @@ class DistributedFilter(JointFilter):
             loop.conclude(target, w.reweighted(weights))
 
 
+@drawn("blue", "-", "s")
 @dataclass
 class MIPF(DistributedFilter):
     """M independent bootstrap PFs: the distributed step with the identity interaction (the final weights are pi).
@@ -260,6 +262,7 @@ class MIPF(DistributedFilter):
         return pi
 
 
+@drawn("vermillion", "-", "*")
 @dataclass
 class BISPF(DistributedFilter):
     """M bootstrap PFs of ``n_particles`` joined by ``n_joint`` (K) bootstrap draws and the MRF potential."""
@@ -278,6 +281,7 @@ class BISPF(DistributedFilter):
         return bootstrap_histograms(particles, pi, self.n_joint, self.beta, state.rng)
 
 
+@drawn("green", "-", "h")
 @dataclass
 class MRFJPF(JointFilter):
     """Joint particle filter over all targets with the MRF interaction (Khan, Balch, Dellaert 2004)."""

@@ -35,6 +35,7 @@ from numba import njit
 
 from replication.filters.bis import neighbours
 from replication.filters.joint import JointFilter, JointState
+from replication.filters.registry import drawn
 
 
 @njit(cache=True)
@@ -100,6 +101,7 @@ def _held(accepted, targets, m):
     return held
 
 
+@drawn("orange", "-", "v")
 @dataclass
 class MCMCPF(JointFilter):
     n_particles: int = 6000  # samples kept per frame after burn-in

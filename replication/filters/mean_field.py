@@ -18,9 +18,11 @@ import numpy as np
 
 from replication.filters.bis import DistributedFilter, cloud_extents, log_potential_table, neighbours, reaching
 from replication.filters.joint import JointState
+from replication.filters.registry import drawn
 from replication.smc.weights import normalise
 
 
+@drawn("purple", "-", "<")
 @dataclass
 class MFMC(DistributedFilter):
     n_particles: int = 400

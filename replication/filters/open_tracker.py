@@ -33,6 +33,7 @@ import pandas as pd
 from replication.boxes import centre_boxes, corner_boxes
 from replication.filters.joint import JointFilter
 from replication.filters.mot_baselines import detection_boxes, detections_only, sort
+from replication.filters.registry import drawn
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.metrics.mot import BOX
 from replication.models.box import BoxModel
@@ -142,11 +143,13 @@ class DetectionTracker:
             yield frame, rows["id"].to_numpy(), rows[BOX].to_numpy(float)
 
 
+@drawn("black")
 def sort_tracker(**settings) -> DetectionTracker:
     """SORT on the public detections (:func:`replication.filters.mot_baselines.sort`)."""
     return DetectionTracker(partial(sort, **settings))
 
 
+@drawn("black", ":", "x")
 def detections_only_tracker(**settings) -> DetectionTracker:
     """The public detections linked frame to frame (:func:`replication.filters.mot_baselines.detections_only`)."""
     return DetectionTracker(partial(detections_only, **settings))

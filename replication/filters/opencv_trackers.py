@@ -35,6 +35,7 @@ import cv2
 import numpy as np
 
 from replication.boxes import centre_boxes, corner_boxes
+from replication.filters.registry import drawn
 from replication.smc.loop import FilterOutput, Summaries
 
 NEIGHBOURS = np.array([[-1, 0], [0, 1], [1, 0], [0, -1]])  # (row, col) steps of the DFT descent
@@ -236,11 +237,13 @@ def _descend(field, template, corner, lower, upper) -> np.ndarray:
         corner, best = candidates[distances.argmin()], distances.min()
 
 
+@drawn("yellow", "-", "*")
 def mil() -> MILTracker:
     """The hspf paper's MIL baseline."""
     return MILTracker()
 
 
+@drawn("purple", "-", "h")
 def dft(**params) -> DFTTracker:
     """The hspf paper's DFT baseline; ``params`` are :class:`DFTTracker` fields."""
     return DFTTracker(**params)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtri
 
+from replication.filters.registry import drawn
 from replication.qmc import POINT_SETS, point_set, random_shift
 from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy
 from replication.smc.resampling import inverse_cdf
@@ -196,6 +197,7 @@ class QMCParticleFilter(ParticleFilter):
         return FilterState(model, rng, particles, log_weights)
 
 
+@drawn("sky", "-", "s")
 def nqmcpf(
     n_particles: int,
     resampling: str = "multinomial",
@@ -218,6 +220,7 @@ def nqmcpf(
     return QMCParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), proposal=source)
 
 
+@drawn("vermillion", "-", "D")
 def gps_qmcpf(
     n_particles: int,
     resampling: str = "multinomial",
@@ -238,6 +241,7 @@ def gps_qmcpf(
     )
 
 
+@drawn("green", "-", "v")
 def tr_sqmc(n_particles: int, randomise: bool = True, points: str = "halton") -> QMCParticleFilter:
     """TR-SQMC, here Gerber & Chopin's SQMC (:class:`SQMCProposal`): QMC resampling inside the proposal."""
     return QMCParticleFilter(

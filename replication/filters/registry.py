@@ -20,7 +20,9 @@ from replication.errors import ConfigError
 from replication.kinds import Registry
 
 GROUP = "replication.filters"
-RESERVED = ("filter", "label")  # a method's keys that are not its builder's parameters
+# a method's keys its builder never sees: filter names the builder, label and look show the method
+# (replication.display), sweep, only and observation plan its runs (replication.runner.config)
+RESERVED = ("filter", "label", "look", "sweep", "only", "observation")
 
 
 def _entry_points():
@@ -52,6 +54,16 @@ def builder(name: str) -> Callable:
 def builders() -> dict[str, Callable]:
     """Every registered builder, by name."""
     return {name: builder(name) for name in sorted(FILTERS)}
+
+
+def drawn(colour: str, line: str = "-", marker: str = "o") -> Callable[[Callable], Callable]:
+    """Declare how the decorated builder's methods are drawn on every figure: a colour of the Okabe-Ito
+    palette by name, a line style and a marker (:mod:`replication.display`, which reads it as
+    ``builder.look``); a method's own ``look:`` says what differs."""
+    def declare(made: Callable) -> Callable:
+        made.look = {"colour": colour, "line": line, "marker": marker}
+        return made
+    return declare
 
 
 def build_filter(method: str, params: dict[str, Any], condition: str = ""):

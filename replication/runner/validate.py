@@ -1,9 +1,10 @@
 """The checks a request passes before any work starts.
 
 Each raises :class:`ConfigError` with one line naming the bad key: a value of
-the wrong type for the filter it goes to, an unknown ``parallel.*`` key or
-backend, an OTB scene whose folder does not exist, a condition a table, a
-figure or a claim names that no run of the experiment has.  :func:`prepare`
+the wrong type for the filter it goes to, a look no figure can draw, an unknown
+``parallel.*`` key or backend, a scene of an unknown kind or a real one whose folder
+does not exist, a condition a table, a figure or a claim names that no run of the
+experiment has.  :func:`prepare`
 runs them all and expands the experiment into its runs.
 """
 
@@ -18,7 +19,8 @@ from replication.errors import ConfigError
 from replication.evidence.curves import figure_conditions
 from replication.evidence.named_conditions import holds, written
 from replication.evidence.tables import matched
-from replication.filters.registry import builder
+from replication.display import asked_look
+from replication.filters.registry import RESERVED, builder
 from replication.paths import experiment_names, resolve
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale, planned
@@ -26,7 +28,6 @@ from replication.scales import at_scale
 from replication.runner.execute import BackendError, check_backend
 from replication.runner.variant import as_shipped
 
-RESERVED_METHOD_KEYS = ("filter", "label", "sweep", "only", "observation")  # read by expand, not by the filter
 PARALLEL_KEYS = ("backend", "address")
 
 
@@ -52,17 +53,19 @@ def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
 
 def check_method_parameters(cfg: DictConfig) -> None:
     """Each method parameter against the type its filter declares (``n_particles: int``),
-    so that ``n_particles=abc`` names the key instead of failing inside ``int()``."""
+    so that ``n_particles=abc`` names the key instead of failing inside ``int()``, and the
+    method's look (its own over its filter's, :mod:`replication.display`)."""
     if not isinstance(cfg.experiment.get("methods"), DictConfig):
         return  # expand says what is wrong
     methods = at_scale(OmegaConf.to_container(cfg.experiment.methods, resolve=True), cfg.scale)
     for method, params in methods.items():
         if not isinstance(params, dict) or "filter" not in params:
             continue  # expand says what is wrong
-        declared = _declared_types(builder(params["filter"]))
-        values = [
-            (f"experiment.methods.{method}.{k}", k, v) for k, v in params.items() if k not in RESERVED_METHOD_KEYS
-        ]
+        made = builder(params["filter"])
+        where = f"experiment.methods.{method}.look" if "look" in params else f"filter {params['filter']!r}: drawn"
+        asked_look(params, getattr(made, "look", None), where)
+        declared = _declared_types(made)
+        values = [(f"experiment.methods.{method}.{k}", k, v) for k, v in params.items() if k not in RESERVED]
         sweep = params.get("sweep")
         if isinstance(sweep, dict):
             values += [
