@@ -6,9 +6,10 @@ distribution registers a user's (``filter: my_pf`` after ``pip install my-pf``);
 installed is named by where it lives (``filter: mypkg.filters:MyPF``, its folder on ``PYTHONPATH``).  A
 builder is a class or function whose keyword parameters are the method's config keys, annotated as the
 built-ins' are (the config check reads them), and it returns an object with ``run(model, observations,
-rng) -> FilterOutput`` (and ``start`` / ``step`` to track in video), as :func:`~.bootstrap.bootstrap` does.
-Everything that can go wrong in finding or building one is one :class:`~replication.errors.ConfigError`
-line naming the filter.
+rng) -> FilterOutput`` (and ``start`` / ``step`` to track in video), as :func:`~.bootstrap.bootstrap` does,
+and may declare how its methods are drawn (:func:`drawn`).  The entry points are read into :data:`FILTERS`
+(a :class:`~replication.kinds.Registry`) at its first lookup.  Everything that can go wrong in finding or
+building one is one :class:`~replication.errors.ConfigError` line naming the filter.
 """
 
 import importlib
