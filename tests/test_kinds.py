@@ -104,3 +104,18 @@ def test_a_real_scene_without_its_sequence_is_refused_whatever_its_benchmark(mak
     with pytest.raises(ConfigError, match=r"^experiment.scenes.exp6_pets09.name: a scene of kind mot names its "
                                           r"MOTChallenge sequence$"):
         check_scenes(cfg)
+
+
+@pytest.mark.parametrize("experiment, scene, kind, said", [
+    ("demo_scene", "synthetic_head", "mot", "a tracking experiment follows a fixed set of targets; a scene whose "
+                                            "people come and go is the mot task's"),
+    ("bis_pf_pets", "exp6_pets09", "otb", "a mot experiment needs model.scene naming a scene whose people come "
+                                          "and go (kind: mot)"),
+])
+def test_a_task_refuses_a_scene_of_the_other_kind_of_targets(make_cfg, experiment, scene, kind, said):
+    """Whether people come and go is the scene kind's (``open_set``), not its name compared."""
+    from replication.runner.config import expand
+
+    with pytest.raises(ConfigError) as error:
+        expand(make_cfg(experiment, "scale=quick", f"experiment.scenes.{scene}.kind={kind}"))
+    assert str(error.value).endswith(said) and "\n" not in str(error.value)
