@@ -10,11 +10,14 @@ top-level name, ``from replication import bootstrap, kalman_filter, VideoSequenc
 * the filters (:mod:`replication.filters`): :func:`bootstrap` and the five papers'
   variants, every registered builder by name (:func:`builders`, the entry points of
   ``replication.filters``, a user's own included), :func:`builder` for one name or
-  import path, :func:`build_filter` to make one from config keys, and :func:`tracker`
-  to step one or many targets through frames;
+  import path, :func:`build_filter` to make one from config keys, :func:`drawn` to
+  declare how a builder's methods look on figures, and :func:`tracker` to step one or
+  many targets through frames;
 * models (:mod:`replication.models`): :class:`LinearGaussian` with its exact
   :func:`kalman_filter`, :class:`UNGM`, :class:`AdditiveGaussianModel` to derive
-  your own scalar model from, :class:`BoxModel` for a target's box in video;
+  your own scalar model from, :class:`BoxModel` for a target's box in video, and the one
+  conversion of a box between its corner (x, y, w, h) and centre (cx, cy, w, h) forms
+  (:func:`centre_boxes`, :func:`corner_boxes`, :func:`centres`);
 * observation models (:mod:`replication.vision`): :class:`ColourHistogram`,
   :class:`ColourLikelihood`, :class:`FusionLikelihood`, the Bhattacharyya coefficient;
 * metrics (:mod:`replication.metrics`): OTB precision and success, CLEAR MOT,
@@ -28,6 +31,8 @@ itself loads neither numpy nor OpenCV and the command line answers at once.  The
 tutorials are ``docs/tutorial_state_space.md`` and ``docs/tutorial_video.md``.
 """
 
+import functools
+
 __version__ = "0.1.0"
 
 _EXPORTS = {  # module: the public names it defines, in the order of the API reference
@@ -36,20 +41,7 @@ _EXPORTS = {  # module: the public names it defines, in the order of the API ref
     ),
     "replication.smc.resampling": ("RESAMPLERS", "multinomial", "residual", "stratified", "systematic"),
     "replication.smc.weights": ("ess", "normalise", "weighted_mean", "weighted_variance"),
-    "replication.filters.registry": ("build_filter", "builder", "builders"),
-    "replication.filters.bootstrap": ("bootstrap",),
-    "replication.filters.point_mass": ("PointMassFilter",),
-    "replication.filters.pso": ("pso",),
-    "replication.filters.ism": ("ism",),
-    "replication.filters.qmc": ("nqmcpf", "gps_qmcpf", "tr_sqmc"),
-    "replication.filters.harmony": ("hspf", "hs"),
-    "replication.filters.mean_shift": ("ms", "mspf"),
-    "replication.filters.bis": ("MIPF", "BISPF", "MRFJPF"),
-    "replication.filters.mean_field": ("MFMC",),
-    "replication.filters.dmot": ("DMOT",),
-    "replication.filters.mcmc": ("MCMCPF",),
-    "replication.filters.opencv_trackers": ("mil", "dft"),
-    "replication.filters.open_tracker": ("sort_tracker", "detections_only_tracker"),
+    "replication.filters.registry": ("build_filter", "builder", "builders", "drawn"),  # then every builder
     "replication.filters.tracker": ("tracker", "Tracker"),
     "replication.models": ("MODELS",),
     "replication.models.additive": ("AdditiveGaussianModel",),
@@ -57,6 +49,7 @@ _EXPORTS = {  # module: the public names it defines, in the order of the API ref
     "replication.models.ungm": ("UNGM",),
     "replication.models.point_mass": ("point_mass_filter",),
     "replication.models.box": ("BoxModel",),
+    "replication.boxes": ("centres", "centre_boxes", "corner_boxes"),
     "replication.models.boosted": ("BoostedBoxModel",),
     "replication.vision.histogram": ("ColourHistogram", "hsv_bin_image"),
     "replication.vision.colour": ("ColourLikelihood",),
@@ -81,21 +74,41 @@ _EXPORTS = {  # module: the public names it defines, in the order of the API ref
     "replication.errors": ("ConfigError",),
     "replication.runner.results": ("load_runs", "load_frames"),
 }
-_MODULE_OF = {name: module for module, names in _EXPORTS.items() for name in names}
 
-__all__ = ["__version__", *_MODULE_OF]  # noqa: PLE0604 (the names of _EXPORTS, written once)
+
+@functools.cache
+def _module_of() -> dict[str, str]:
+    """Each public name's module: :data:`_EXPORTS`, and after the filters' registry every builder this
+    package registers (its entry points, :data:`~replication.filters.registry.FILTERS`), so a new filter
+    is a public name by its registration alone.  Read at the first use, not at import."""
+    from replication.errors import ConfigError
+    from replication.filters.registry import FILTERS
+
+    try:
+        builders = {point.attr: point.module for point in FILTERS.values()
+                    if point.module.startswith(f"{__name__}.")}
+    except ConfigError:  # not installed: no builder is registered (naming one in a config says so)
+        builders = {}
+    found = {}
+    for module, names in _EXPORTS.items():
+        found.update(dict.fromkeys(names, module))
+        if module == "replication.filters.registry":
+            found.update(builders)
+    return found
 
 
 def __getattr__(name: str):
-    """Import a public name's module on first use and keep the name here (PEP 562)."""
+    """``__all__`` and each public name, its module imported on first use and the name kept here (PEP 562)."""
     from importlib import import_module
 
-    if name not in _MODULE_OF:
+    if name == "__all__":
+        return ["__version__", *_module_of()]
+    if name not in _module_of():
         raise AttributeError(f"module 'replication' has no attribute {name!r}")
-    value = getattr(import_module(_MODULE_OF[name]), name)
+    value = getattr(import_module(_module_of()[name]), name)
     globals()[name] = value
     return value
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+    return sorted({*globals(), "__all__", "__version__", *_module_of()})

@@ -41,6 +41,7 @@ from replication.errors import ConfigError, fail
 from replication.paths import experiment_names, resolve
 from replication.run import Run
 from replication.runner.results import stored_records
+from replication.scenes.factory import OTB, scene_kind
 
 LAYOUTS = {"otb": "OTB2015", "got10k": "GOT-10k"}  # layout: the toolkit's folder under its result_dir
 
@@ -52,7 +53,7 @@ def tracker_name(run: Run) -> str:
 
 
 def on_otb(run: Run) -> bool:
-    return run.task == "tracking" and run.model.get("scene_spec", {}).get("kind") == "otb"
+    return run.task == "tracking" and scene_kind(run.model.get("scene_spec", {})) is OTB
 
 
 def write_results(runs: list[Run], records: pd.DataFrame, out_dir: str | Path, layout: str) -> list[Path]:

@@ -22,7 +22,7 @@ def test_import_replication_loads_no_numerical_library():
 @pytest.mark.parametrize("name", replication.__all__)
 def test_every_public_name_resolves_to_its_module(name):
     value = getattr(replication, name)
-    module = replication._MODULE_OF.get(name)
+    module = replication._module_of().get(name)
     if hasattr(value, "__qualname__"):  # a class or function is the one its module defines, not a copy
         assert value.__module__ == module and getattr(sys.modules[module], name) is value
     assert name in dir(replication)

@@ -15,9 +15,7 @@ from replication.report import figures
 from replication.report.figures import metric as metric_figures, tracking as tracking_figures
 from replication.evidence.published import load_published
 from replication.evidence.curves import clip_diverged
-from replication.report.figures.style import (
-    METHODS, PALETTE, NothingToDraw, axis_label, method_look,
-)
+from replication.report.figures.style import PALETTE, NothingToDraw, axis_label, method_look
 
 PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
     "qmc,1,ungm,PF,rmse,N=100,9.2,,",
@@ -56,20 +54,57 @@ def _label(fig, label: str) -> str:
     return next(t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts() if t.get_text().startswith(label))
 
 
-def test_every_method_of_the_configs_has_a_look_of_its_own():
-    looks = list(METHODS.values())
-    assert len(set(looks)) == len(looks)
-    assert {look.colour for look in looks} <= set(PALETTE)
-    configured = {m for path in (CONF_DIR / "experiment").glob("*.yaml")
-                  for m in (yaml.safe_load(path.read_text()).get("methods") or {})}
-    assert configured <= set(METHODS), sorted(configured - set(METHODS))
-    own = method_look("my-filter")  # a user's own method: stable, and unlike every known one
-    assert own == method_look("my-filter") and own not in looks and own.colour in PALETTE
+def test_every_method_of_the_configs_has_a_look_of_its_own(make_cfg):
+    """A method's look (its filter's, with its own look: over it) is the same in every shipped experiment that
+    has it and no other method's; a user's own method that asks for none takes a spare one, stable, and
+    unlike every other method's of its experiment."""
+    from omegaconf import OmegaConf
+
+    from replication.paths import experiment_names
+
+    looks: dict[str, set] = {}
+    for name in experiment_names():
+        experiment = OmegaConf.to_container(make_cfg(name).experiment, resolve=True)
+        for method in experiment.get("methods") or {}:
+            looks.setdefault(method, set()).add(method_look(experiment, method))
+    assert len(looks) >= 40 and all(len(found) == 1 for found in looks.values()), looks
+    shipped = [look for found in looks.values() for look in found]
+    assert len(set(shipped)) == len(shipped) and {look.colour for look in shipped} <= set(PALETTE)
+    mine = {"methods": {"PF": {"filter": "bootstrap"}, "my-filter": {}}}
+    own = method_look(mine, "my-filter")
+    assert own == method_look(mine, "my-filter") and own != method_look(mine, "PF") and own.colour in PALETTE
+
+
+@pytest.mark.parametrize("look, said", [
+    ("{colour: pink}", "experiment.methods.PF.look: unknown colour 'pink'; known colours: black, blue, green, "
+                       "orange, purple, sky, vermillion, yellow"),
+    ("{colour: sky, line: dotted}", "experiment.methods.PF.look: unknown line 'dotted'; known lines: '-', '--', "
+                                    "'-.', ':'"),
+    ("{colour: sky, width: 2}", "experiment.methods.PF.look: unknown part 'width' of a look; a look has colour, "
+                                "line, marker"),
+])
+def test_a_look_no_figure_can_draw_is_one_line_before_any_run(make_cfg, look, said):
+    from replication.errors import ConfigError
+    from replication.runner.validate import prepare
+
+    with pytest.raises(ConfigError) as error:
+        prepare(make_cfg("hspf_ungm", "scale=quick", f"+experiment.methods.PF.look={look}"))
+    assert str(error.value) == said
+
+
+def test_a_look_is_no_part_of_a_run(make_cfg):
+    from replication.runner.config import expand
+
+    plain, drawn = (expand(make_cfg("hspf_ungm", "scale=quick", *extra))
+                    for extra in ((), ("+experiment.methods.PF.look={colour: sky, marker: s}",)))
+    assert [run.key for run in plain] == [run.key for run in drawn]
+    assert all("look" not in run.method_params for run in drawn)
 
 
 def test_a_method_looks_the_same_on_figures_of_two_experiments(drawn, tmp_path):
-    ungm = {"paper": "qmc", "methods": {"PF": {"label": "PF (bootstrap)"}, "grid": {}}}
-    tracking = {"paper": "trk", "methods": {"ISM-PF": {}, "PF": {"label": "PF"}}}
+    ungm = {"paper": "qmc", "methods": {"PF": {"label": "PF (bootstrap)", "filter": "bootstrap"},
+                                        "grid": {"filter": "point_mass"}}}
+    tracking = {"paper": "trk", "methods": {"ISM-PF": {"filter": "ism"}, "PF": {"label": "PF", "filter": "bootstrap"}}}
     rng = np.random.default_rng(0)
     figures.draw(_scalar_records({("PF", f"N={n}"): list(rng.uniform(4, 5, 5)) for n in (100, 500)}
                                  | {("grid", ""): [4.0, 4.1]}),
@@ -78,10 +113,10 @@ def test_a_method_looks_the_same_on_figures_of_two_experiments(drawn, tmp_path):
                                     "PF": rng.uniform(0, 5, (4, 30)).tolist()}),
                  {"kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png")
     pf = [_lines(fig, "PF")[0] for fig in drawn]
-    assert {to_hex(line.get_color()) for line in pf} == {method_look("PF").colour.lower()}
-    assert {line.get_marker() for line in pf} == {method_look("PF").marker}
-    assert to_hex(_lines(drawn[1], "ISM-PF")[0].get_color()) == method_look("ISM-PF").colour.lower()
-    assert to_hex(_lines(drawn[0], "grid")[0].get_color()) == method_look("grid").colour
+    assert {to_hex(line.get_color()) for line in pf} == {method_look(ungm, "PF").colour.lower()} == {"#0072b2"}
+    assert {line.get_marker() for line in pf} == {method_look(tracking, "PF").marker}
+    assert to_hex(_lines(drawn[1], "ISM-PF")[0].get_color()) == method_look(tracking, "ISM-PF").colour.lower()
+    assert to_hex(_lines(drawn[0], "grid")[0].get_color()) == method_look(ungm, "grid").colour
     assert drawn[0].axes[0].get_xlabel() == "number of particles N"
     assert drawn[1].axes[0].get_ylabel() == "centre location error (px)"
 
@@ -95,15 +130,15 @@ def test_axis_labels_read_in_words_with_the_raw_name_as_fallback():
 def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_path):
     csv = tmp_path / "published.csv"
     csv.write_text(PUBLISHED)
-    experiment = {"paper": "qmc", "methods": {"PF": {}, "NQMCPF": {}}}
+    experiment = {"paper": "qmc", "methods": {"PF": {"filter": "bootstrap"}, "NQMCPF": {"filter": "nqmcpf"}}}
     records = _scalar_records({(m, f"N={n}"): [4.0, 4.5, 5.0] for m in ("PF", "NQMCPF") for n in (100, 200, 500)})
     spec = {"kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
             "paper_x": {"ungm": 200}}
     figures.draw(records, spec, experiment, tmp_path / "f.png", published=load_published(str(csv)))
     paper = {to_hex(line.get_markeredgecolor()): (list(line.get_xdata()), list(line.get_ydata()))
              for line in _lines(drawn[0], "paper")}
-    assert paper == {method_look("PF").colour.lower(): ([100, 500], [9.2, 4.2]),
-                     method_look("NQMCPF").colour.lower(): ([200], [3.3])}
+    assert paper == {method_look(experiment, "PF").colour.lower(): ([100, 500], [9.2, 4.2]),
+                     method_look(experiment, "NQMCPF").colour.lower(): ([200], [3.3])}
     assert all(line.get_marker() == "D" and line.get_markerfacecolor() == "none" for line in _lines(drawn[0], "paper"))
     legend = [t.get_text() for t in drawn[0].axes[0].get_legend().get_texts()]
     assert legend.count("paper") == 1

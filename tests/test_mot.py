@@ -9,7 +9,7 @@ from mot_cases import needs_mot
 
 from replication.paths import resolve
 from replication.scenes import load_mot
-from replication.scenes.factory import SequenceMissing
+from replication.scenes.base import SequenceMissing
 from replication.scenes.mot import MOT_ROOT
 
 

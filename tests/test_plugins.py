@@ -47,10 +47,10 @@ def installed(tmp_path, monkeypatch):
         (info / "entry_points.txt").write_text(
             f"[{registry.GROUP}]\n" + "".join(f"{name} = {value}\n" for name, value in points.items()))
         monkeypatch.syspath_prepend(str(info.parent))
-        registry.registered.cache_clear()
+        registry.FILTERS.forget()
 
     yield install
-    registry.registered.cache_clear()
+    registry.FILTERS.forget()
 
 
 def test_the_built_ins_come_in_by_the_entry_points_this_package_declares():
@@ -158,6 +158,59 @@ def test_a_plugins_runs_are_keyed_by_its_own_source(make_cfg, tmp_path, monkeypa
     (copy / "auxiliary_pf" / "__init__.py").write_text((copy / "auxiliary_pf" / "__init__.py").read_text() + "#\n")
     assert keys()["APF"] != after["APF"]  # its package runs on import too
     for name in [name for name in sys.modules if name.split(".")[0] == "auxiliary_pf"]:
+        del sys.modules[name]
+
+
+STEADY = '''"""A new filter: the bootstrap filter under a name of its own, drawn in a look of its own."""
+
+from replication.filters.bootstrap import bootstrap
+from replication.filters.registry import drawn
+
+
+@drawn("yellow", "-.", "X")
+def steady(n_particles: int):
+    return bootstrap(n_particles)
+'''
+
+
+def test_a_new_filter_is_its_file_its_registration_and_its_yaml_entry(make_cfg, installed, keep_figures, tmp_path,
+                                                                     monkeypatch):
+    """A filter's module (declaring its look), its entry point and one method in an experiment's YAML: it runs
+    beside the papers' methods, is labelled in the tables and drawn in its look, with no other file changed."""
+    from matplotlib.colors import to_hex
+
+    from replication.report.figures import draw, metric
+    from replication.report.pages.experiment import write_experiment_report
+    from replication.runner.execute import execute
+    from replication.runner.results import Results
+    from replication.runner.store import Store
+    from replication.runner.validate import prepare
+
+    package = _tree_digest(PACKAGE_DIR)
+    (tmp_path / "filters" / "my_filters").mkdir(parents=True)
+    (tmp_path / "filters" / "my_filters" / "__init__.py").write_text("")
+    (tmp_path / "filters" / "my_filters" / "steady.py").write_text(STEADY)
+    monkeypatch.syspath_prepend(str(tmp_path / "filters"))
+    installed(steady="my_filters.steady:steady")
+    cfg = make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=2",
+                   "+experiment.methods.Steady={filter: steady, sweep: {n_particles: [50, 100]}}")
+    runs, _, _ = prepare(cfg)
+    store = Store(tmp_path / "experiments", "hspf_ungm")
+    execute([run for run in runs if run.method in ("PF", "Steady")], store, n_jobs=1, progress=False)
+    results = Results.of(cfg, runs, store)
+    records = results.records
+    assert len(records[records["method"] == "Steady"]) == 4 and records["rmse"].notna().all()
+    drawn = keep_figures(metric)
+    page = write_experiment_report(cfg, results)
+    table = (page.parent / "table1_rmse.csv").read_text()
+    assert "\nSteady,N=50," in table and "\nPF (bootstrap),-," in table  # its key (no label:)
+    draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, results.experiment,
+         tmp_path / "rmse.png")
+    line = next(line for ax in drawn[-1].axes for c in ax.containers if c.get_label().startswith("Steady")
+                for line in c.lines[:1])
+    assert (to_hex(line.get_color()), line.get_linestyle(), line.get_marker()) == ("#f0e442", "-.", "X")
+    assert _tree_digest(PACKAGE_DIR) == package  # nothing under replication/ changed
+    for name in [name for name in sys.modules if name.split(".")[0] == "my_filters"]:
         del sys.modules[name]
 
 

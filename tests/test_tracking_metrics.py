@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from replication.boxes import centre_boxes, centres, corner_boxes
 from replication.metrics import multi
 from replication.metrics import tracking as tm
 from replication.metrics.means import fsum_mean
@@ -49,8 +50,8 @@ def test_mean_error_per_target_and_track_loss():
     est = np.zeros((4, 2, 2))
     est[:, 1, 0] = [3, 30, 30, 4]
     assert multi.mean_error_per_target(est, truth) == pytest.approx((3 + 30 + 30 + 4) / 8)
-    np.testing.assert_array_equal(multi.track_losses(est, truth, threshold=10, patience=2), [False, True])
-    np.testing.assert_array_equal(multi.track_losses(est, truth, threshold=10, patience=3), [False, False])
+    np.testing.assert_array_equal(multi.loss_onsets(est, truth, threshold=10, patience=2), [4, 1])  # 4: never
+    np.testing.assert_array_equal(multi.loss_onsets(est, truth, threshold=10, patience=3), [4, 4])
 
 
 def test_clear_mot_hand_case_with_a_swap():
@@ -123,3 +124,17 @@ def test_the_multi_target_errors_are_their_distances_exact_means():
     onsets = np.array([1, 4])  # target 0 lost from frame 1: its first frame, and target 1's four
     assert multi.tracked_error(estimates, truth, onsets) == (1e16 + 4) / 5
     assert multi.ospa(estimates, truth, cutoff=20.0) == (10.5 + 1 + 1 + 0.5) / 4
+
+
+def test_one_box_conversion_both_ways():
+    """Corner (x, y, w, h) and centre (cx, cy, w, h) boxes: x + w / 2 (the same bits as x + 0.5 w), back to the
+    corner within rounding, exactly for whole-pixel boxes, a state's further coordinates (velocity) ignored."""
+    rng = np.random.default_rng(5)
+    boxes = np.column_stack([rng.uniform(-50, 500, (200, 2)), rng.uniform(0.5, 80, (200, 2))])
+    centred = centre_boxes(boxes)
+    np.testing.assert_array_equal(centred, np.column_stack([boxes[:, :2] + 0.5 * boxes[:, 2:], boxes[:, 2:]]))
+    np.testing.assert_array_equal(centres(boxes), centred[:, :2])
+    np.testing.assert_allclose(corner_boxes(centred), boxes, rtol=0, atol=1e-12)
+    whole = np.array([[3, 4, 10, 7], [0, 0, 1, 1]])  # a synthetic scene's truth: integers
+    np.testing.assert_array_equal(corner_boxes(centre_boxes(whole)), whole)
+    assert corner_boxes(np.array([10.0, 20.0, 4.0, 6.0, 1.0, -1.0])).tolist() == [8.0, 17.0, 4.0, 6.0]

@@ -4,6 +4,7 @@ import numpy as np
 from conftest import SMALL
 
 from replication import bootstrap
+from replication.boxes import corner_boxes
 from replication.metrics.tracking import centre_error
 from replication.models.box import BoxModel
 from replication.runner.config import expand
@@ -28,7 +29,7 @@ def test_colour_pf_follows_a_distinct_ball():
     likelihood = ColourLikelihood.from_frame(scene.frame(0), start, ColourHistogram(grid=(18, 18)), sigma=0.1)
     model = BoxModel(start, likelihood, step_sd=(3.0, 3.0, 0.3, 0.3))
     output = bootstrap(200).run(model, (scene.frame(k) for k in range(1, 60)), np.random.default_rng(0))
-    errors = centre_error(BoxModel.boxes(output.means), scene.truth[1:, 0])
+    errors = centre_error(corner_boxes(output.means), scene.truth[1:, 0])
     assert errors.mean() < 2.0 and errors.max() < 5.0, errors
     assert output.degenerate.sum() == 0
 
@@ -41,7 +42,7 @@ def test_a_lost_filter_is_measured_as_lost():
     likelihood = ColourLikelihood.from_frame(scene.frame(0), start, ColourHistogram(grid=(18, 18)), sigma=0.1)
     model = BoxModel(start + [100, 60, 0, 0], likelihood, step_sd=(0.5, 0.5, 0.1, 0.1), initial_sd=(0.5, 0.5, 0.1, 0.1))
     output = bootstrap(50).run(model, (scene.frame(k) for k in range(1, 30)), np.random.default_rng(0))
-    assert centre_error(BoxModel.boxes(output.means), scene.truth[1:30, 0]).min() > 40
+    assert centre_error(corner_boxes(output.means), scene.truth[1:30, 0]).min() > 40
 
 
 def test_demo_experiment_runs_and_skips_a_missing_sequence(make_cfg, tmp_path):

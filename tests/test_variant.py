@@ -41,8 +41,9 @@ def test_more_runs_are_the_same_experiment_and_a_bad_label_is_refused(make_cfg):
 
 
 def test_sequences_read_from_a_folder_named_in_the_environment_are_the_users(make_cfg, monkeypatch):
-    from replication.runner import sequences, variant
+    from replication.runner import variant
+    from replication.scenes.factory import OTB
 
-    monkeypatch.setitem(sequences.DEFAULT_ROOTS, "otb", "/data/my_otb")  # as $REPLICATION_OTB sets it at import
+    monkeypatch.setattr(OTB, "root", "/data/my_otb")  # as $REPLICATION_OTB sets it at import
     found = variant.differences(make_cfg("hspf", "scale=quick"))
     assert found[0] == "data.otb: ../shared/data/otb -> /data/my_otb (from the environment)"

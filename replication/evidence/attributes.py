@@ -19,6 +19,7 @@ from replication.condition import label_of, values_of
 from replication.evidence.quantities import quantity
 from replication.evidence.settings import INFERENCE
 from replication.evidence.statistics import stratified_mean
+from replication.scenes.factory import OTB, scene_kind
 from replication.scenes.otb import otb_attributes
 
 METRICS = ("precision20", "success_auc")  # OTB's two scores
@@ -32,7 +33,7 @@ def sequence_attributes(records: pd.DataFrame, experiment: dict) -> pd.DataFrame
     rows = []
     for index, scene, series in zip(records.index, values_of(records, "scene"), label_of(records, ("scene",))):
         spec = experiment.get("scenes", {}).get(scene or fixed, {})
-        if spec.get("kind") == "otb" and spec["name"] in listed:
+        if scene_kind(spec) is OTB and spec["name"] in listed:
             rows.append((index, spec["name"], series, tuple(listed[spec["name"]])))
     index, sequences, series, attributes = zip(*rows) if rows else ((), (), (), ())
     known = records.loc[list(index)].copy()

@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit
 
 from replication.compiled import pairwise_sum
+from replication.filters.registry import drawn
 from replication.smc.loop import (
     FilterOutput,
     FilterState,
@@ -331,6 +332,7 @@ class DistributedFilter(JointFilter):
             target.particles, target.log_weights = particles, uniform
 
 
+@drawn("blue", "-", "s")
 @dataclass
 class MIPF(DistributedFilter):
     """M independent bootstrap PFs: the distributed step with the identity interaction (the final weights are pi).
@@ -350,6 +352,7 @@ class MIPF(DistributedFilter):
         return pi
 
 
+@drawn("vermillion", "-", "*")
 @dataclass
 class BISPF(DistributedFilter):
     """M bootstrap PFs of ``n_particles`` joined by ``n_joint`` (K) bootstrap draws and the MRF potential."""
@@ -368,6 +371,7 @@ class BISPF(DistributedFilter):
         return bootstrap_histograms(particles, pi, self.n_joint, self.beta, state.rng)
 
 
+@drawn("green", "-", "h")
 @dataclass
 class MRFJPF(JointFilter):
     """Joint particle filter over all targets with the MRF interaction (Khan, Balch, Dellaert 2004)."""

@@ -25,8 +25,10 @@ from numba import njit
 from replication.compiled import matvec
 from replication.filters.bis import DistributedFilter, neighbours
 from replication.filters.joint import JointState
+from replication.filters.registry import drawn
 
 
+@drawn("sky", "-", ">")
 @dataclass
 class DMOT(DistributedFilter):
     n_particles: int = 400

@@ -56,6 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replication.filters.registry import drawn
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 from replication.smc.weights import logsumexp
 from replication.vision.likelihood import gaussian_similarity_log_likelihood
@@ -249,6 +250,7 @@ class HarmonyMove:
         return moved, log_compensation(particles, moved, self.compensation)
 
 
+@drawn("vermillion", "-", "P")
 def hspf(
     n_particles: int, resampling: str = "systematic", ess_threshold: float = 1.0, **harmony
 ) -> ParticleFilter:
@@ -263,6 +265,7 @@ def hold(model, particles, log_weights, t, rng):
     return particles, log_weights
 
 
+@drawn("green", "--", "^")
 def hs(**harmony) -> ParticleFilter:
     """The paper's HS tracker: one harmony memory around the previous estimate, which moves to its best
     harmony; one particle, so no weights and no resampling."""

@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from replication.filters.registry import drawn
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 
 UPDATES = ("additive", "replace")
@@ -117,6 +118,7 @@ class ISMMove:
         return np.where(np.isfinite(moved), moved, particles), np.zeros(n)
 
 
+@drawn("vermillion", "-", "^")
 def ism(n_particles: int, resampling: str = "systematic", ess_threshold: float = 1.0, **sharing) -> ParticleFilter:
     """ISM-PF: the SMC loop with the information-sharing move; ``sharing`` are :class:`ISMMove` fields."""
     return ParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), move=ISMMove(**sharing))

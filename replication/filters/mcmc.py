@@ -36,6 +36,7 @@ from numba import njit
 from replication.filters.bis import _extents, _meeting
 from replication.filters.frame import BoxTargets
 from replication.filters.joint import JointFilter, JointState
+from replication.filters.registry import drawn
 
 
 @njit(cache=True)
@@ -101,6 +102,7 @@ def _held(accepted, targets, m):
     return held
 
 
+@drawn("orange", "-", "v")
 @dataclass
 class MCMCPF(JointFilter):
     n_particles: int = 6000  # samples kept per frame after burn-in

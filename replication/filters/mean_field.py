@@ -22,8 +22,10 @@ from replication.compiled import matvec
 from replication.filters.bis import DistributedFilter, _meeting, cloud_extents, log_potential_table
 from replication.filters.frame import normalise_in_place, refuse
 from replication.filters.joint import JointState
+from replication.filters.registry import drawn
 
 
+@drawn("purple", "-", "<")
 @dataclass
 class MFMC(DistributedFilter):
     n_particles: int = 400

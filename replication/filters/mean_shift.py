@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from replication.filters.harmony import COMPENSATIONS, hold, log_compensation
+from replication.filters.registry import drawn
 from replication.smc.loop import ParticleFilter, ResamplingPolicy
 
 
@@ -113,6 +114,7 @@ class MeanShiftFilter(ParticleFilter):
         super().step(state, z)
 
 
+@drawn("sky", "--", ">")
 def mspf(
     n_particles: int, resampling: str = "multinomial", ess_threshold: float = 1.0, **mean_shift_params
 ) -> MeanShiftFilter:
@@ -122,6 +124,7 @@ def mspf(
     return MeanShiftFilter(n_particles, policy, move=MeanShiftMove(**mean_shift_params))
 
 
+@drawn("orange", "-", "<")
 def ms(**mean_shift_params) -> MeanShiftFilter:
     """The MS tracker: one box, no motion model (it starts from the previous estimate, as HS does),
     moved by mean shift; no weights and no resampling."""

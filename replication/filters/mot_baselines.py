@@ -15,6 +15,7 @@ images, hence their own module rather than a builder in ``FILTERS``.
 import numpy as np
 import pandas as pd
 
+from replication.boxes import centres, corner_boxes
 from replication.metrics.mot import BOX, match_boxes
 
 COLUMNS = ["frame", "id", *BOX]
@@ -70,14 +71,14 @@ P0 = np.diag([4.0, 4.0, 1000.0, 0.05, 10.0, 10.0, 1000.0]) ** 2
 
 def _to_measurement(boxes: np.ndarray) -> np.ndarray:
     w, h = boxes[:, 2], boxes[:, 3]
-    return np.column_stack([boxes[:, 0] + w / 2, boxes[:, 1] + h / 2, w * h, w / h])
+    return np.column_stack([centres(boxes), w * h, w / h])
 
 
 def _to_box(states: np.ndarray) -> np.ndarray:
     area, ratio = np.clip(states[:, 2], 1e-6, None), states[:, 3]
     w = np.sqrt(area * ratio)
     h = area / w
-    return np.column_stack([states[:, 0] - w / 2, states[:, 1] - h / 2, w, h])
+    return corner_boxes(np.column_stack([states[:, :2], w, h]))
 
 
 def sort(

@@ -30,11 +30,12 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
+from replication.boxes import centre_boxes, corner_boxes
 from replication.filters.joint import JointFilter
 from replication.filters.mot_baselines import detection_boxes, detections_only, sort
+from replication.filters.registry import drawn
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.metrics.mot import BOX
-from replication.metrics.tracking import centres
 from replication.models.box import BoxModel
 
 # Which of a live track's frames are output, from whether a detection is associated with it this frame and
@@ -45,11 +46,6 @@ OUTPUTS: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
     "alive": lambda detected, supported: np.ones_like(supported),
 }
 Frame = tuple[int, np.ndarray, np.ndarray]  # MOT frame number, ids (K,), boxes (K, 4)
-
-
-def _centred(boxes: np.ndarray) -> np.ndarray:
-    """(cx, cy, w, h) of (x, y, w, h) boxes."""
-    return np.column_stack([centres(boxes), boxes[:, 2:4]])
 
 
 EVENTS = ("births", "track_frames", "detected_frames", "colour_frames", "shown_frames", "died_unsupported",
@@ -93,11 +89,11 @@ class ParticleTracker:
             found = detections.get(frame, np.zeros((0, 4)))
             assigned = associate(boxes, found, self.association_iou)
             for model, index in zip(state.models, assigned):
-                model.detection = _centred(found[index : index + 1])[0] if index >= 0 else None
+                model.detection = centre_boxes(found[index]) if index >= 0 else None
             if len(ids):
                 self.method.step(state, image)
                 means = np.array([records.means[-1][:4] for records in state.records])
-                boxes = BoxModel.boxes(means)
+                boxes = corner_boxes(means)
                 rho = np.array([model.similarity(mean[None], image, state.t)[0] for model, mean in zip(state.models, means)])
                 detected = assigned >= 0
                 supported = self.deaths.supported(detected, rho)
@@ -118,7 +114,7 @@ class ParticleTracker:
             taken = np.isin(np.arange(len(found)), assigned)
             born = self.births.step(found[~taken], boxes)
             for box in born:
-                self.method.add(state, self.new_model(image, _centred(box[None])[0]))
+                self.method.add(state, self.new_model(image, centre_boxes(box)))
             new_ids = np.arange(self.born + 1, self.born + len(born) + 1)
             self.counts.update({"births": len(born), "shown_frames": len(born)})
             self.born += len(born)
@@ -147,11 +143,13 @@ class DetectionTracker:
             yield frame, rows["id"].to_numpy(), rows[BOX].to_numpy(float)
 
 
+@drawn("black")
 def sort_tracker(**settings) -> DetectionTracker:
     """SORT on the public detections (:func:`replication.filters.mot_baselines.sort`)."""
     return DetectionTracker(partial(sort, **settings))
 
 
+@drawn("black", ":", "x")
 def detections_only_tracker(**settings) -> DetectionTracker:
     """The public detections linked frame to frame (:func:`replication.filters.mot_baselines.detections_only`)."""
     return DetectionTracker(partial(detections_only, **settings))

@@ -34,6 +34,8 @@ from typing import Any
 import cv2
 import numpy as np
 
+from replication.boxes import centre_boxes, corner_boxes
+from replication.filters.registry import drawn
 from replication.smc.loop import FilterOutput, Summaries
 
 NEIGHBOURS = np.array([[-1, 0], [0, 1], [1, 0], [0, -1]])  # (row, col) steps of the DFT descent
@@ -63,8 +65,8 @@ class BoxState:
 
 def corner_box(box: np.ndarray) -> tuple[int, int, int, int]:
     """Integer (x, y, w, h) of a (cx, cy, w, h) box."""
-    cx, cy, w, h = np.asarray(box, dtype=float)[:4]
-    return int(round(cx - w / 2)), int(round(cy - h / 2)), int(round(w)), int(round(h))
+    x, y, w, h = corner_boxes(box)
+    return int(round(x)), int(round(y)), int(round(w)), int(round(h))
 
 
 class BoxTracker(ABC):
@@ -117,8 +119,8 @@ class MILTracker(BoxTracker):
         return tracker
 
     def update(self, tracker, frame):
-        found, (x, y, w, h) = tracker.update(frame)
-        return np.array([x + w / 2, y + h / 2, w, h], dtype=float) if found else None
+        found, corner = tracker.update(frame)
+        return centre_boxes(corner) if found else None
 
 
 @dataclass
@@ -207,7 +209,7 @@ class DFTTracker(BoxTracker):
         ]
         corner = corner + top
         memory.motion, memory.corner = corner - memory.corner, corner
-        return np.array([corner[1] + size[1] / 2, corner[0] + size[0] / 2, size[1], size[0]], dtype=float)
+        return centre_boxes([corner[1], corner[0], size[1], size[0]])  # (row, col) -> (x, y)
 
 
 def _grey(frame: np.ndarray) -> np.ndarray:
@@ -235,11 +237,13 @@ def _descend(field, template, corner, lower, upper) -> np.ndarray:
         corner, best = candidates[distances.argmin()], distances.min()
 
 
+@drawn("yellow", "-", "*")
 def mil() -> MILTracker:
     """The hspf paper's MIL baseline."""
     return MILTracker()
 
 
+@drawn("purple", "-", "h")
 def dft(**params) -> DFTTracker:
     """The hspf paper's DFT baseline; ``params`` are :class:`DFTTracker` fields."""
     return DFTTracker(**params)

@@ -4,10 +4,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from replication.filters.registry import drawn
 from replication.models.point_mass import point_mass_filter
 from replication.smc.loop import FilterOutput
 
 
+@drawn("black", "--", "")
 @dataclass(frozen=True)
 class PointMassFilter:
     """Grid filter with ``n_points`` over ``[-half_width, half_width]``; uses no randomness."""

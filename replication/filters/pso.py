@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from replication.filters.qmc import NQMCProposal
+from replication.filters.registry import drawn
 from replication.smc.loop import ParticleFilter, ResamplingPolicy, prior_proposal
 
 PERSONAL_BESTS = ("frame", "history")
@@ -85,6 +86,7 @@ class PSOMove:
         return positions[frame, columns], values[frame, columns]
 
 
+@drawn("orange", "-", "s")
 def pso(n_particles: int, resampling: str = "systematic", ess_threshold: float = 1.0, points: str | None = None,
         **swarm) -> ParticleFilter:
     """Bootstrap PF with a PSO move between prediction and weighting; ``swarm`` are :class:`PSOMove` fields.

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtri
 
+from replication.filters.registry import drawn
 from replication.libm import exp, log
 from replication.qmc import POINT_SETS, point_set, random_shift
 from replication.smc.loop import FilterState, ParticleFilter, ResamplingPolicy
@@ -197,6 +198,7 @@ class QMCParticleFilter(ParticleFilter):
         return FilterState(model, rng, particles, log_weights)
 
 
+@drawn("sky", "-", "s")
 def nqmcpf(
     n_particles: int,
     resampling: str = "multinomial",
@@ -219,6 +221,7 @@ def nqmcpf(
     return QMCParticleFilter(n_particles, ResamplingPolicy(resampling, ess_threshold), proposal=source)
 
 
+@drawn("vermillion", "-", "D")
 def gps_qmcpf(
     n_particles: int,
     resampling: str = "multinomial",
@@ -239,6 +242,7 @@ def gps_qmcpf(
     )
 
 
+@drawn("green", "-", "v")
 def tr_sqmc(n_particles: int, randomise: bool = True, points: str = "halton") -> QMCParticleFilter:
     """TR-SQMC, here Gerber & Chopin's SQMC (:class:`SQMCProposal`): QMC resampling inside the proposal."""
     return QMCParticleFilter(

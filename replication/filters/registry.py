@@ -6,25 +6,27 @@ distribution registers a user's (``filter: my_pf`` after ``pip install my-pf``);
 installed is named by where it lives (``filter: mypkg.filters:MyPF``, its folder on ``PYTHONPATH``).  A
 builder is a class or function whose keyword parameters are the method's config keys, annotated as the
 built-ins' are (the config check reads them), and it returns an object with ``run(model, observations,
-rng) -> FilterOutput`` (and ``start`` / ``step`` to track in video), as :func:`~.bootstrap.bootstrap` does.
-Everything that can go wrong in finding or building one is one :class:`~replication.errors.ConfigError`
-line naming the filter.
+rng) -> FilterOutput`` (and ``start`` / ``step`` to track in video), as :func:`~.bootstrap.bootstrap` does,
+and may declare how its methods are drawn (:func:`drawn`).  The entry points are read into :data:`FILTERS`
+(a :class:`~replication.kinds.Registry`) at its first lookup.  Everything that can go wrong in finding or
+building one is one :class:`~replication.errors.ConfigError` line naming the filter.
 """
 
-import functools
 import importlib
 import importlib.metadata
 from collections.abc import Callable
 from typing import Any
 
 from replication.errors import ConfigError
+from replication.kinds import Registry
 
 GROUP = "replication.filters"
-RESERVED = ("filter", "label")  # a method's keys that are not its builder's parameters
+# a method's keys its builder never sees: filter names the builder, label and look show the method
+# (replication.display), sweep, only and observation plan its runs (replication.runner.config)
+RESERVED = ("filter", "label", "look", "sweep", "only", "observation")
 
 
-@functools.cache
-def registered() -> dict[str, importlib.metadata.EntryPoint]:
+def _entry_points():
     """Every entry point of :data:`GROUP`, by name; two distributions registering one name is an error."""
     found: dict[str, importlib.metadata.EntryPoint] = {}
     for point in importlib.metadata.entry_points(group=GROUP):
@@ -35,23 +37,34 @@ def registered() -> dict[str, importlib.metadata.EntryPoint]:
     if not found:
         raise ConfigError(f"no filter is registered under {GROUP}: install this package (make setup, or "
                           "pip install -e .)")
-    return found
+    return found.items()
+
+
+FILTERS: Registry[importlib.metadata.EntryPoint] = Registry("filter", load=_entry_points,
+                                                            hint=" (or an import path, module:name)")
 
 
 def builder(name: str) -> Callable:
     """The builder ``name`` names: an import path ``module:attribute`` or a registered entry point."""
     if not isinstance(name, str) or not name:
         raise ConfigError(f"filter must name a builder (a registered name or module:name), got {name!r}")
-    if ":" not in name and name not in registered():
-        raise ConfigError(f"unknown filter {name!r}; known filters: {', '.join(sorted(registered()))} "
-                          "(or an import path, module:name)")
-    module, _, attribute = (name if ":" in name else registered()[name].value).partition(":")
+    module, _, attribute = (name if ":" in name else FILTERS[name].value).partition(":")
     return _callable(name, _attribute(name, _module(name, module), attribute))
 
 
 def builders() -> dict[str, Callable]:
     """Every registered builder, by name."""
-    return {name: builder(name) for name in sorted(registered())}
+    return {name: builder(name) for name in sorted(FILTERS)}
+
+
+def drawn(colour: str, line: str = "-", marker: str = "o") -> Callable[[Callable], Callable]:
+    """Declare how the decorated builder's methods are drawn on every figure: a colour of the Okabe-Ito
+    palette by name, a line style and a marker (:mod:`replication.display`, which reads it as
+    ``builder.look``); a method's own ``look:`` says what differs."""
+    def declare(made: Callable) -> Callable:
+        made.look = {"colour": colour, "line": line, "marker": marker}
+        return made
+    return declare
 
 
 def build_filter(method: str, params: dict[str, Any], condition: str = ""):

@@ -98,11 +98,6 @@ def off_every_target(estimates: np.ndarray, truth: np.ndarray, threshold: float)
     return _pairwise(estimates, truth).min(axis=-1) > threshold
 
 
-def track_losses(estimates: np.ndarray, truth: np.ndarray, threshold: float, patience: int) -> np.ndarray:
-    """(M,) bool: target m is lost when its estimate stays over ``threshold`` px away for ``patience`` frames."""
-    return loss_onsets(estimates, truth, threshold, patience) < len(estimates)
-
-
 def tracked_error(estimates: np.ndarray, truth: np.ndarray, onsets: np.ndarray) -> float:
     """The error while tracked: the mean per-identity error over each target's frames before its first loss
     (``onsets``: :func:`loss_onsets`); NaN when every target is lost at once."""

@@ -20,6 +20,7 @@ GOT-10k's own evaluation (``ExperimentGOT10k.report``) leaves it out.
 
 import numpy as np
 
+from replication.boxes import centres
 from replication.metrics.means import fsum_mean
 
 PRECISION_THRESHOLDS = np.arange(0, 51)
@@ -32,11 +33,6 @@ COUNT_FIRST_FRAME = True
 def scored_frames(per_frame: np.ndarray, count_first_frame: bool = COUNT_FIRST_FRAME) -> np.ndarray:
     """The frames (first axis) of a one-pass run that the OTB scores count; see :data:`COUNT_FIRST_FRAME`."""
     return np.asarray(per_frame)[0 if count_first_frame else 1 :]
-
-
-def centres(boxes: np.ndarray) -> np.ndarray:
-    boxes = np.asarray(boxes, dtype=float)
-    return boxes[..., :2] + boxes[..., 2:4] / 2.0
 
 
 def outside_image(boxes: np.ndarray, size) -> np.ndarray:

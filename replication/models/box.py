@@ -158,12 +158,6 @@ class BoxModel:
         if hasattr(self.likelihood, "adapt") and self.cache.get("t") == t:
             self.likelihood.adapt(estimate[:4], self.cache["prepared"])
 
-    @staticmethod
-    def boxes(states: np.ndarray) -> np.ndarray:
-        """(x, y, w, h) boxes of states (..., >= 4) given as (cx, cy, w, h, ...)."""
-        states = np.asarray(states)
-        return np.concatenate([states[..., :2] - states[..., 2:4] / 2.0, states[..., 2:4]], axis=-1)
-
 
 class NoiseSources(NamedTuple):
     """W (d, k) as one noise term per coordinate, for :func:`_moved`: the k normals are drawn as ``blocks``

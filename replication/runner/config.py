@@ -9,7 +9,8 @@ by its path (``sweep: {deaths.frames: [5, 10]}`` sets ``model.deaths.frames``). 
 included (a velocity clamp, histogram bins).  A method's ``only:`` block
 (``only: {scene: [a]}``) keeps it to the conditions with those values; its
 ``observation:`` block overrides keys of ``model.observation`` (fusion_pf's two
-filters differ only there).  Everything is checked
+filters differ only there); its ``label:`` and ``look:`` show it (:mod:`replication.display`)
+and are no part of its runs' keys.  Everything is checked
 before any work starts, and errors are one line that names the bad key.
 """
 
@@ -88,9 +89,7 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     """
     exp = cfg.experiment
     repetitions = n_runs(cfg)
-    if exp.get("task") not in TASKS:
-        raise ConfigError(f"unknown task {exp.get('task')!r}; known tasks: {', '.join(sorted(TASKS))}")
-    task = TASKS[exp.task]
+    task = TASKS[exp.get("task")]
     experiment = experiment_at_scale(cfg)
     scenes = experiment.get("scenes", {})
     runs, skipped = [], [] if skipped is None else skipped
@@ -139,6 +138,7 @@ def planned(experiment: dict) -> Iterator[tuple[str, Condition, Condition, dict,
         sweeps = model_sweeps + _sweeps(params, False, f"methods.{method}")
         only = params.pop("only", None) or {}  # e.g. {scene: [exp1_3123]}: a method run on some conditions only
         observation = params.pop("observation", None) or {}  # e.g. fusion_pf's colour-only filter: {alpha: 1}
+        params.pop("look", None)  # how its figures draw it (replication.display): no part of a run
         for values in itertools.product(*(values for _, _, values in sweeps)):
             run_model, run_params = dict(model), dict(params)
             if observation:

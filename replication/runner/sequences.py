@@ -13,23 +13,19 @@ list is given once.
 
 from replication.errors import ConfigError
 from replication.paths import resolve
-from replication.scenes.mot import MOT_ROOT, SHIPPED_MOT_ROOT, find_mot, mot_names
-from replication.scenes.otb import OTB_ROOT, SHIPPED_OTB_ROOT, find_otb, otb_names
-
-DEFAULT_ROOTS = {"otb": OTB_ROOT, "mot": MOT_ROOT}  # $REPLICATION_OTB / $REPLICATION_MOT, else the shipped data
-SHIPPED_ROOTS = {"otb": SHIPPED_OTB_ROOT, "mot": SHIPPED_MOT_ROOT}
+from replication.scenes.factory import SCENE_KINDS, SceneKind, scene_kind
 
 
 def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] | str | None) -> dict:
     """``experiment`` (plain data at its scale) with its real scenes' roots filled in, the user's
     ``sequences`` in place of its real ones (and in its report's figures and tables), and a scene sweep over
     every scene where none is named."""
-    roots = {kind: (data or {}).get(kind) or default for kind, default in DEFAULT_ROOTS.items()}
+    roots = {kind: (data or {}).get(kind.name) or kind.root for kind in SCENE_KINDS.values() if kind.real}
     for kind, root in roots.items():
-        if (data or {}).get(kind) and not resolve(root).is_dir():
-            raise ConfigError(f"data.{kind}: no folder {resolve(root)}")
+        if (data or {}).get(kind.name) and not resolve(root).is_dir():
+            raise ConfigError(f"data.{kind.name}: no folder {resolve(root)}")
     scenes = {
-        name: {**spec, "root": spec.get("root", roots[spec["kind"]])} if spec.get("kind") in roots else spec
+        name: {**spec, "root": spec.get("root", roots[kind])} if (kind := scene_kind(spec)).real else spec
         for name, spec in (experiment.get("scenes") or {}).items()
     }
     model = dict(experiment.get("model") or {})
@@ -37,7 +33,7 @@ def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] |
     if sequences is not None:
         shipped = set(scenes)
         scenes = own_sequences(scenes, sequences, roots)
-        sweep["scene"] = [name for name, spec in scenes.items() if spec.get("kind") in FINDERS]
+        sweep["scene"] = [name for name, spec in scenes.items() if scene_kind(spec).real]
         report = follow_sequences(experiment.get("report") or {}, shipped - set(scenes), sweep["scene"])
         experiment = {**experiment, "report": report}
     elif scenes and model.get("scene") is None and "scene" not in sweep:
@@ -49,24 +45,24 @@ def locate_sequences(experiment: dict, data: dict | None, sequences: list[str] |
     return {**experiment, "scenes": scenes, "model": model} if scenes else experiment
 
 
-def own_sequences(scenes: dict, sequences: list[str] | str, roots: dict[str, str]) -> dict:
-    """``scenes`` with the user's ``sequences`` in place of its real ones (OTB where it has some, else
-    MOTChallenge), each read like the experiment's first real scene of that kind (its synthetic ones stay,
-    unswept)."""
-    kind = next((k for k in FINDERS if any(spec.get("kind") == k for spec in scenes.values())), None)
+def own_sequences(scenes: dict, sequences: list[str] | str, roots: dict[SceneKind, str]) -> dict:
+    """``scenes`` with the user's ``sequences`` in place of its real ones (of the first real kind it has, in
+    the order of :data:`~replication.scenes.factory.SCENE_KINDS`: OTB, else MOTChallenge), each read like the
+    experiment's first real scene of that kind (its synthetic ones stay, unswept)."""
+    kinds = {name: scene_kind(spec) for name, spec in scenes.items()}
+    kind = next((k for k in roots if k in kinds.values()), None)
     if kind is None:
         raise ConfigError("sequences= replaces the real sequences of an experiment that has some (OTB: hspf, "
                           "ism_pf_otb, fusion_pf_otb, gps_qmcpf_otb; MOTChallenge: bis_pf_pets)")
-    names_of, find = FINDERS[kind]
-    names = names_of(roots[kind]) if sequences == "all" else sequences
+    names = kind.names(roots[kind]) if sequences == "all" else sequences
     if isinstance(names, str) or not names or not all(isinstance(n, str) for n in names):
-        raise ConfigError(f"sequences must be a list of {kind.upper()} sequence names or all, got {sequences!r}")
-    _, missing = find(list(names), roots[kind])
+        raise ConfigError(f"sequences must be a list of {kind.benchmark} sequence names or all, got {sequences!r}")
+    _, missing = kind.find(list(names), roots[kind])
     if missing:
         raise ConfigError(f"sequences: {missing[0].removesuffix(': skipped')}")
-    shipped = [spec for spec in scenes.values() if spec.get("kind") == kind]
+    shipped = [scenes[name] for name, of in kinds.items() if of is kind]
     template = {k: v for k, v in shipped[0].items() if k not in ("name", "stand_in")}
-    kept = {name: spec for name, spec in scenes.items() if spec.get("kind") != kind}
+    kept = {name: spec for name, spec in scenes.items() if kinds[name] is not kind}
     return {**kept, **{name: {**template, "name": name, "root": str(roots[kind])} for name in names}}
 
 
@@ -85,5 +81,3 @@ def follow_sequences(report: dict, replaced: set[str], scenes: list[str]) -> dic
     return {**report, **{part: [moved(spec) for spec in report.get(part, [])] for part in ("tables", "figures")
                          if part in report}}
 
-
-FINDERS = {"otb": (otb_names, find_otb), "mot": (mot_names, find_mot)}  # a kind of real sequence: list, find

@@ -1,9 +1,10 @@
 """The checks a request passes before any work starts.
 
 Each raises :class:`ConfigError` with one line naming the bad key: a value of
-the wrong type for the filter it goes to, an unknown ``parallel.*`` key or
-backend, an OTB scene whose folder does not exist, a condition a table, a
-figure or a claim names that no run of the experiment has.  :func:`prepare`
+the wrong type for the filter it goes to, a look no figure can draw, an unknown
+``parallel.*`` key or backend, a scene of an unknown kind or a real one whose folder
+does not exist, a condition a table, a figure or a claim names that no run of the
+experiment has.  :func:`prepare`
 runs them all and expands the experiment into its runs.
 """
 
@@ -18,7 +19,8 @@ from replication.errors import ConfigError
 from replication.evidence.curves import figure_conditions
 from replication.evidence.named_conditions import holds, written
 from replication.evidence.tables import matched
-from replication.filters.registry import builder
+from replication.display import asked_look
+from replication.filters.registry import RESERVED, builder
 from replication.paths import experiment_names, resolve
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale, planned
@@ -26,7 +28,6 @@ from replication.scales import at_scale
 from replication.runner.execute import BackendError, check_backend
 from replication.runner.variant import as_shipped
 
-RESERVED_METHOD_KEYS = ("filter", "label", "sweep", "only", "observation")  # read by expand, not by the filter
 PARALLEL_KEYS = ("backend", "address")
 
 
@@ -52,17 +53,19 @@ def parallel_settings(cfg: DictConfig) -> tuple[str, int, str | None]:
 
 def check_method_parameters(cfg: DictConfig) -> None:
     """Each method parameter against the type its filter declares (``n_particles: int``),
-    so that ``n_particles=abc`` names the key instead of failing inside ``int()``."""
+    so that ``n_particles=abc`` names the key instead of failing inside ``int()``, and the
+    method's look (its own over its filter's, :mod:`replication.display`)."""
     if not isinstance(cfg.experiment.get("methods"), DictConfig):
         return  # expand says what is wrong
     methods = at_scale(OmegaConf.to_container(cfg.experiment.methods, resolve=True), cfg.scale)
     for method, params in methods.items():
         if not isinstance(params, dict) or "filter" not in params:
             continue  # expand says what is wrong
-        declared = _declared_types(builder(params["filter"]))
-        values = [
-            (f"experiment.methods.{method}.{k}", k, v) for k, v in params.items() if k not in RESERVED_METHOD_KEYS
-        ]
+        made = builder(params["filter"])
+        where = f"experiment.methods.{method}.look" if "look" in params else f"filter {params['filter']!r}: drawn"
+        asked_look(params, getattr(made, "look", None), where)
+        declared = _declared_types(made)
+        values = [(f"experiment.methods.{method}.{k}", k, v) for k, v in params.items() if k not in RESERVED]
         sweep = params.get("sweep")
         if isinstance(sweep, dict):
             values += [
@@ -109,26 +112,33 @@ def _type_mismatch(value: typing.Any, declared: typing.Any) -> str | None:
 
 
 def check_scenes(cfg: DictConfig) -> None:
-    """An OTB scene names its sequence, and a ``root:`` given for it exists.
+    """Every scene is of a known kind, and a real one names its sequence and exists at a ``root:`` given.
 
-    (A sequence absent from the shared OTB folder is not an error: its
+    (A sequence absent from the shared folder is not an error: its
     conditions are skipped, so the suite runs on machines without the data.)
     """
-    from replication.scenes.otb import OTB_ROOT
+    from replication.scenes.factory import scene_kind
 
     if not isinstance(cfg.experiment.get("scenes"), DictConfig):
         return
     scenes = at_scale(OmegaConf.to_container(cfg.experiment.scenes, resolve=True), cfg.scale)
     for name, spec in scenes.items():
-        if not isinstance(spec, dict) or spec.get("kind") != "otb":
+        if not isinstance(spec, dict):
+            continue
+        try:
+            kind = scene_kind(spec)
+        except ConfigError as error:
+            raise ConfigError(f"experiment.scenes.{name}.kind: {error}") from None
+        if not kind.real:
             continue
         if not isinstance(spec.get("name"), str) or not spec["name"]:
-            raise ConfigError(f"experiment.scenes.{name}.name: an OTB scene names its sequence (e.g. name: Girl)")
+            raise ConfigError(f"experiment.scenes.{name}.name: a scene of kind {kind.name} names its "
+                              f"{kind.benchmark} sequence")
         if "root" in spec:
             root = resolve(str(spec["root"]))
             if not root.is_dir():
                 raise ConfigError(
-                    f"experiment.scenes.{name}.root: no folder {root} (leave root out for the shared {OTB_ROOT})"
+                    f"experiment.scenes.{name}.root: no folder {root} (leave root out for the shared {kind.root})"
                 )
 
 

@@ -21,7 +21,7 @@ from omegaconf.errors import OmegaConfBaseException
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, experiment_names
 from replication.runner.config import experiment_at_scale
-from replication.runner.sequences import DEFAULT_ROOTS, SHIPPED_ROOTS
+from replication.scenes.factory import SCENE_KINDS, scene_kind
 
 SHOWN = 12  # differences listed on a page; the digest covers them all
 NOT_COMPARED = ("runs", "also")  # the run count (the same experiment, repeated more or less) and the companions
@@ -38,9 +38,9 @@ def differences(cfg: DictConfig) -> list[str]:
     except (HydraException, OmegaConfBaseException):  # renamed inside its file: not the package's
         return [f"experiment {cfg.experiment.name}: not one the package ships"]
     ours = experiment_at_scale(cfg)
-    kinds = {spec.get("kind") for spec in (ours.get("scenes") or {}).values()}
-    moved = [f"data.{kind}: {SHIPPED_ROOTS[kind]} -> {root} (from the environment)"
-             for kind, root in DEFAULT_ROOTS.items() if kind in kinds and root != SHIPPED_ROOTS[kind]]
+    kinds = {scene_kind(spec) for spec in (ours.get("scenes") or {}).values()}
+    moved = [f"data.{kind.name}: {kind.shipped_root} -> {kind.root} (from the environment)"
+             for kind in SCENE_KINDS.values() if kind in kinds and kind.real and kind.root != kind.shipped_root]
     return moved + [line for line in _diff(shipped, ours) if not line.startswith(NOT_COMPARED)]
 
 

@@ -16,7 +16,7 @@ from replication.errors import fail
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.scales import SCALES, at_scale
 from replication.scenes.export import write_sequence
-from replication.scenes.factory import build_sequence
+from replication.scenes.factory import build_sequence, scene_kind
 
 OPTIONS = ("experiment", "scale", "scene", "out", "format", "boxes")
 
@@ -40,7 +40,7 @@ def main(argv: list[str]) -> None:
     scenes = OmegaConf.to_container(cfg.experiment.scenes, resolve=True) if "scenes" in cfg.experiment else {}
     scenes = at_scale(scenes, cfg.scale)  # a scene's frames may differ by scale ({paper: 1000, quick: 100})
     chosen = options.pop("scene", None)
-    synthetic = {k: v for k, v in scenes.items() if v.get("kind", "synthetic") == "synthetic" and chosen in (None, k)}
+    synthetic = {k: v for k, v in scenes.items() if not scene_kind(v).real and chosen in (None, k)}
     if not synthetic:
         fail(f"experiment {name!r} has no synthetic scene{' ' + repr(chosen) if chosen else ''}")
     for spec in synthetic.values():

@@ -1,4 +1,4 @@
-"""The interface every image sequence gives to trackers, metrics and figures."""
+"""The interface every image sequence gives to trackers, metrics and figures, and the absence of a real one."""
 
 from typing import Protocol
 
@@ -24,6 +24,5 @@ class Sequence(Protocol):
     def frame(self, k: int) -> np.ndarray: ...
 
 
-def box_centres(boxes: np.ndarray) -> np.ndarray:
-    """Centres (x + w/2, y + h/2) of boxes (..., 4)."""
-    return boxes[..., :2] + boxes[..., 2:4] / 2.0
+class SequenceMissing(LookupError):
+    """A real sequence that is not on this machine: skip it, do not fail."""

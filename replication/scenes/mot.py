@@ -21,8 +21,8 @@ import numpy as np
 import pandas as pd
 
 from replication.paths import resolve
+from replication.scenes.base import SequenceMissing
 from replication.scenes.kept import decoded
-from replication.scenes.factory import SequenceMissing
 
 SHIPPED_MOT_ROOT = "../shared/data/mot"  # where the project's own MOTChallenge sequences are, beside it
 MOT_ROOT = os.environ.get("REPLICATION_MOT") or SHIPPED_MOT_ROOT  # data.mot in conf/config.yaml

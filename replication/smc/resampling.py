@@ -24,6 +24,8 @@ from collections.abc import Callable
 import numpy as np
 from numba import njit
 
+from replication.kinds import Registry
+
 Resampler = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 
 
@@ -250,9 +252,9 @@ def residual(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return np.concatenate([deterministic, random_part])
 
 
-RESAMPLERS: dict[str, Resampler] = {
+RESAMPLERS: Registry[Resampler] = Registry("resampling scheme", {
     "multinomial": multinomial,
     "stratified": stratified,
     "systematic": systematic,
     "residual": residual,
-}
+})

@@ -7,9 +7,12 @@ also has ``frame_table(record) -> DataFrame``, a row per frame (and target or tr
 :func:`replication.runner.results.frames` gathers.
 """
 
-from replication.scenes.factory import SequenceMissing as DataMissing
+from types import ModuleType
+
+from replication.kinds import Registry
+from replication.scenes.base import SequenceMissing as DataMissing
 from replication.tasks import mot, scalar, tracking
 
-TASKS = {"scalar": scalar, "tracking": tracking, "mot": mot}
+TASKS: Registry[ModuleType] = Registry("task", {"scalar": scalar, "tracking": tracking, "mot": mot})
 
 __all__ = ["TASKS", "DataMissing"]

@@ -34,6 +34,7 @@ from replication.metrics.mot import (
 )
 from replication.models.boosted import BoostedBoxModel
 from replication.run import Run
+from replication.scenes.factory import scene_kind
 from replication.scenes.mot import MOT_ROOT, load_mot
 from replication.smc.work import Counted, Work
 from replication.tasks.tracking import histogram_args
@@ -90,8 +91,8 @@ def _model_builder(run_model: dict, rng: np.random.Generator, work: Work):
 
 def check(model: dict, method: dict) -> None:
     spec = model.get("scene_spec")
-    if spec is None or spec.get("kind") != "mot":
-        raise ValueError("a mot experiment needs model.scene naming a scene of kind: mot")
+    if spec is None or not scene_kind(spec).open_set:
+        raise ValueError("a mot experiment needs model.scene naming a scene whose people come and go (kind: mot)")
     unknown = (set(spec) - SCENE_KEYS) | (set(model) - MODEL_KEYS)
     if unknown:
         raise ValueError(f"unknown keys {sorted(unknown)}")

@@ -17,6 +17,7 @@ averages (mean CLE, shares of correct frames) are over the frames it filtered.
 import numpy as np
 import pandas as pd
 
+from replication.boxes import centre_boxes, centres, corner_boxes
 from replication.filters.registry import build_filter
 from replication.filters.tracker import Adaptation, Marginal
 from replication.filters.tracker import tracker as make_tracker
@@ -27,7 +28,7 @@ from replication.metrics.mot import BOX
 from replication.metrics.scalar import filter_diagnostics
 from replication.models.box import BoxModel
 from replication.run import Run
-from replication.scenes.factory import cached_sequence
+from replication.scenes.factory import cached_sequence, scene_kind
 from replication.smc.work import Counted, Work
 from replication.vision.colour import ColourLikelihood
 from replication.vision.fusion import FusionLikelihood
@@ -58,6 +59,9 @@ def scene_spec(run: Run) -> dict:
 def check(model: dict, method: dict) -> None:
     if "scene_spec" not in model:
         raise ValueError("a tracking experiment needs model.scene naming one of experiment.scenes")
+    if scene_kind(model["scene_spec"]).open_set:
+        raise ValueError("a tracking experiment follows a fixed set of targets; a scene whose people come and go "
+                         "is the mot task's")
     if model["scene_spec"].get("scene_seed", "fixed") not in SCENE_SEEDS:
         raise ValueError(f"unknown scene_seed {model['scene_spec']['scene_seed']!r}; choose one of {SCENE_SEEDS}")
     observation = model.get("observation", {})
@@ -87,9 +91,8 @@ def histogram_args(observation: dict, box_size, rng) -> dict:
 
 def build_model(run: Run, sequence, target: int, cache: dict) -> BoxModel:
     observation = run.model.get("observation", {})
-    x, y, w, h = sequence.truth[0, target]
-    initial = np.array([x + w / 2, y + h / 2, w, h])
-    histogram = ColourHistogram(**histogram_args(observation, (w, h), run.rng(f"pattern{target}")))
+    initial = centre_boxes(sequence.truth[0, target])
+    histogram = ColourHistogram(**histogram_args(observation, initial[2:4], run.rng(f"pattern{target}")))
     first = sequence.frame(0)
     if observation.get("kind", "colour") == "fusion":
         fusion = {k: observation[k] for k in FUSION_KEYS if k in observation}
@@ -123,7 +126,7 @@ def multi_target_scores(evaluation: dict, estimates: np.ndarray, truth: np.ndarr
     """
     threshold = evaluation.get("loss_threshold", 20.0)
     start = max(int(evaluation.get("from_frame", 2)) - 1, 1)
-    estimated, true = tm.centres(estimates), tm.centres(truth)
+    estimated, true = centres(estimates), centres(truth)
     errors = np.linalg.norm(estimated - true, axis=-1)[start:]
     visible = visibility[start:] >= 0.5
     patience = evaluation.get("loss_patience", 10)
@@ -183,7 +186,7 @@ def run(run: Run) -> dict:
     seconds = sum(tracker.frame_seconds)
     outputs = tracker.outputs()
     diagnostics = [filter_diagnostics(output) for output in outputs]
-    boxes = [BoxModel.boxes(output.means) for output in outputs]
+    boxes = [corner_boxes(output.means) for output in outputs]
     estimates = np.stack([np.vstack([sequence.truth[:1, t], b]) for t, b in zip(chosen, boxes)], axis=1)  # (T, M, 4)
     truth = sequence.truth[:, chosen]
     errors, overlaps = tm.centre_error(estimates, truth), tm.iou(estimates, truth)  # (T, M)

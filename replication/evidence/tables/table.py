@@ -16,6 +16,7 @@ from typing import ClassVar
 import numpy as np
 import pandas as pd
 
+from replication.display import method_label
 from replication.errors import ConfigError
 from replication.evidence.named_conditions import as_mapping, holds, instead_of, written
 from replication.evidence.published import cells
@@ -188,7 +189,7 @@ class TableKind:
         raise NotImplementedError
 
     def label(self, method: str) -> str:
-        return self.experiment["methods"].get(method, {}).get("label", method)
+        return method_label(self.experiment, method)
 
     def theirs(self) -> pd.DataFrame:
         spec = self.spec

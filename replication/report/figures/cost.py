@@ -17,7 +17,8 @@ from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.quantities import quantity  # noqa: E402
 from replication.evidence.statistics import mean  # noqa: E402
 from replication.report.figures.base import figure  # noqa: E402
-from replication.report.figures.style import axis_label, method_label, method_look, save, shades  # noqa: E402
+from replication.display import method_label  # noqa: E402
+from replication.report.figures.style import axis_label, method_look, save, shades  # noqa: E402
 
 COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted, and the time it took
 
@@ -47,7 +48,7 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
         lines = points.groupby("method", sort=False)["line"].unique()  # a method's lines: shades of its colour
         for (method, line), group in points.groupby(["method", "line"], sort=False):
             group = group.sort_values("cost")
-            look, label = method_look(method), f"{method_label(experiment, method)} {line}".strip()
+            look, label = method_look(experiment, method), f"{method_label(experiment, method)} {line}".strip()
             colour = shades(look.colour, len(lines[method]))[list(lines[method]).index(line)]
             drawn = {**look.line(), "color": colour}
             if len(group) > 1:  # a line through its budgets, its interval a band

@@ -14,12 +14,12 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from replication.condition import label_of, values_of  # noqa: E402
+from replication.display import method_label  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.published import cells  # noqa: E402
 from replication.evidence.curves import clip_diverged, clip_level  # noqa: E402
 from replication.report.figures.style import (  # noqa: E402
-    BLACK, PAPER, axis_label, clipped_note, method_label, method_look, save,
-    shades,
+    BLACK, PAPER, axis_label, clipped_note, method_look, save, shades,
 )
 from replication.report.figures.base import figure  # noqa: E402
 
@@ -48,7 +48,7 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
     summary["x"] = pd.to_numeric(values_of(summary, spec["x"]), errors="coerce").astype(float)
     summary["panel"] = ["" if v is None else str(v) for v in values_of(summary, spec.get("by"))]
     summary["rest"] = label_of(summary, without=(spec["x"], spec.get("by")), sep=" ")
-    colours = _series_colours(summary)
+    colours = _series_colours(summary, experiment)
     paper = (paper_points(published, spec, experiment, set(summary["method"]))
              if published is not None and "paper_table" in spec else None)
     reference = summary["x"].isna() & (summary["panel"] == "")  # e.g. the Bayes floor: drawn in every panel
@@ -66,8 +66,8 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
             ax.axhspan(row["ci_low"], row["ci_high"], color=colour, alpha=0.1)
         if paper is not None:
             for method, points in paper.groupby("method", sort=False):
-                ax.plot(points["x"], points["value"], **PAPER, markeredgecolor=method_look(method).colour,
-                        label="paper", zorder=3)
+                ax.plot(points["x"], points["value"], **PAPER, label="paper", zorder=3,
+                        markeredgecolor=method_look(experiment, method).colour)
         _axes(ax, spec, list(rows["x"].dropna()) + (list(paper["x"]) if paper is not None else []))
         ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
         title = f"{axis_label(spec['by'])}: {panel}" if panel else spec.get("title", "")
@@ -89,9 +89,8 @@ def _series(ax, rows: pd.DataFrame, colours: dict, spec: dict, experiment: dict)
         label += clipped_note(group["diverged"].sum(), group["total"].sum())
         x = _nudged(group["x"], i - (len(series) - 1) / 2, rows["x"], spec.get("log_x", True))
         below, above = group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]
-        ax.errorbar(x, group["mean"], yerr=[below, above],
-                    **{**method_look(method).line(), "color": colours[method, rest]}, markersize=5, capsize=2,
-                    elinewidth=0.8, label=label)
+        ax.errorbar(x, group["mean"], yerr=[below, above], **{**method_look(experiment, method).line(),
+                    "color": colours[method, rest]}, markersize=5, capsize=2, elinewidth=0.8, label=label)
 
 
 def _nudged(x: pd.Series, step: float, every_x: pd.Series, log: bool) -> pd.Series:
@@ -138,13 +137,13 @@ def _clipped(records: pd.DataFrame, metric: str, spec: dict) -> tuple[pd.Series,
     return clipped, diverged
 
 
-def _series_colours(summary: pd.DataFrame) -> dict[tuple[str, str], tuple]:
+def _series_colours(summary: pd.DataFrame, experiment: dict) -> dict[tuple[str, str], tuple]:
     """(method, other parameters) -> colour: the method's own, in shades (dark to light, in the
     parameters' natural order) where it has several series."""
     colours = {}
     for method, group in summary.groupby("method", sort=False):
         rests = sorted(set(group["rest"]), key=_natural)
-        colours.update(zip([(method, r) for r in rests], shades(method_look(method).colour, len(rests))))
+        colours.update(zip([(method, r) for r in rests], shades(method_look(experiment, method).colour, len(rests))))
     return colours
 
 

@@ -26,7 +26,8 @@ from PIL import Image
 
 from replication.metrics.mot import BOX, clear_mot_matches
 from replication.condition import PREFIX, values_of
-from replication.report.figures.style import method_label, save
+from replication.display import method_label
+from replication.report.figures.style import save
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
 from replication.tasks.mot import frame_table
 from replication.report.figures.base import figure

@@ -1,17 +1,15 @@
 """How every figure of the report looks and is written: one look per method, human axis labels, diverged
 runs clipped, the figure saved (or, where the runs cannot make it, :class:`NothingToDraw`).
 
-A method (its config key) has the same colour, line style and marker on every
-figure of every experiment.  The colours are the Okabe-Ito palette, safe for
-colour-blind readers; line style and marker keep more methods than colours
-apart, and in print.  By convention blue is a plain particle filter and
-vermillion the method a paper proposes; black is the Bayes-optimal reference.
-A paper's own values are hollow diamonds in the method's colour.
+A method has the same colour, line style and marker on every figure of every experiment: the look its
+filter declares, with its own ``look:`` over it (:mod:`replication.display`); a method that has neither
+takes a spare look, chosen by a stable hash of its key among those no other method of its experiment has.
+Line style and marker keep more methods than colours apart, and in print.  A paper's own values are
+hollow diamonds in the method's colour.
 """
 
 import re
 import zlib
-from dataclasses import dataclass
 from itertools import product
 from pathlib import Path
 
@@ -19,97 +17,39 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import to_rgb
 
-ORANGE, SKY, GREEN, YELLOW = "#E69F00", "#56B4E9", "#009E73", "#F0E442"
-BLUE, VERMILLION, PURPLE, BLACK = "#0072B2", "#D55E00", "#CC79A7", "#000000"
-PALETTE = (ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILLION, PURPLE, BLACK)  # Okabe and Ito (2008)
+from replication.display import COLOURS, LINES, MARKERS, Look, asked_look
+from replication.errors import ConfigError
+from replication.filters.registry import builder
+
+PALETTE = tuple(COLOURS.values())
+BLACK = COLOURS["black"]
 # a verdict's colour in figures, as on the report's pages (base.html.j2): keyed by Outcome's value
 OUTCOME_COLOURS = {"reproduced": "#1a7f37", "inconclusive": "#8a5a00", "not reproduced": "#b42318",
                    "not testable": "#999999"}
-LINESTYLES = ("-", "--", "-.", ":")
-MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*", "<", ">", "h")
-
-
-@dataclass(frozen=True)
-class Look:
-    """A method's colour, line style and marker ("" for none)."""
-
-    colour: str
-    linestyle: str
-    marker: str
-
-    def line(self) -> dict:
-        """Keyword arguments of ``Axes.plot``."""
-        return {"color": self.colour, "linestyle": self.linestyle, "marker": self.marker or "None"}
-
-
-METHODS = {  # config key -> look; every method of conf/experiment/*.yaml
-    # plain particle filters
-    "PF": Look(BLUE, "-", "o"),
-    # the baselines over an N sweep, for error against cost (hspf, gps_qmcpf, fusion_pf)
-    "PF-N": Look(BLUE, ":", "<"),
-    "NQMCPF-N": Look(SKY, ":", "<"),
-    "TR-SQMC-N": Look(GREEN, ":", "<"),
-    "colour-only-N": Look(BLUE, ":", "s"),
-    "MIPF": Look(BLUE, "-", "s"),
-    "color-only PF": Look(BLUE, "--", "s"),
-    "colour-sigma-0.1": Look(SKY, "--", "s"),
-    # what each paper proposes
-    "ISM-PF": Look(VERMILLION, "-", "^"),
-    "GPS-QMCPF": Look(VERMILLION, "-", "D"),
-    "BIS-PF": Look(VERMILLION, "-", "*"),
-    "HSPF": Look(VERMILLION, "-", "P"),
-    "color+structure fusion PF": Look(VERMILLION, "-", "X"),
-    # variants of a proposal
-    "ISM-PF-literal": Look(PURPLE, "--", "v"),
-    "GPS-QMCPF-fixed": Look(ORANGE, "--", "D"),
-    "BIS-PF-beta": Look(VERMILLION, "--", "s"),
-    "BIS-PF-K": Look(VERMILLION, ":", "D"),
-    "fusion-sigma-0.1": Look(ORANGE, "--", "X"),
-    "PSO-GPS": Look(PURPLE, "-.", "P"),
-    # the papers' competitors
-    "NQMCPF": Look(SKY, "-", "s"),
-    "TR-SQMC": Look(GREEN, "-", "v"),
-    "PSO-PF": Look(ORANGE, "-", "s"),
-    "MRF-JPF": Look(GREEN, "-", "h"),
-    "MCMC": Look(ORANGE, "-", "v"),
-    "MFMC": Look(PURPLE, "-", "<"),
-    "DMOT": Look(SKY, "-", ">"),
-    "HS": Look(GREEN, "--", "^"),
-    "MS": Look(ORANGE, "-", "<"),
-    "MSPF": Look(SKY, "--", ">"),
-    "DFT": Look(PURPLE, "-", "h"),
-    "MIL": Look(YELLOW, "-", "*"),
-    # references on the public detections alone (bis_pf_pets)
-    "SORT": Look(BLACK, "-", "o"),
-    "Detections": Look(BLACK, ":", "x"),
-    # the Bayes-optimal reference (point-mass filter)
-    "grid": Look(BLACK, "--", ""),
-    # ablations: ISM-PF's c1, fusion_pf's fixed alpha
-    "ISM-c1-0.2": Look(SKY, "-", "^"),
-    "ISM-c1-0.5": Look(GREEN, "-", "^"),
-    "ISM-c1-0.8": Look(VERMILLION, "--", "^"),
-    "ISM-c1-1.0": Look(PURPLE, "-", "^"),
-    "alpha-0": Look(GREEN, "-", "o"),
-    "alpha-0.25": Look(SKY, "-", "o"),
-    "alpha-0.5": Look(PURPLE, "-", "o"),
-    "alpha-0.75": Look(YELLOW, "-", "o"),
-    "alpha-1": Look(BLUE, ":", "o"),
-}
-SPARE = [look for look in (Look(c, s, m) for c, s, m in product(PALETTE[:-1], LINESTYLES, MARKERS))
-         if look not in METHODS.values()]
+SPARE = [Look(c, s, m) for c, s, m in product(PALETTE[:-1], LINES, MARKERS)]
 PAPER = {"marker": "D", "markersize": 8, "markerfacecolor": "none", "markeredgewidth": 1.6,  # a published value
          "linestyle": "None"}
 
 
-def method_look(method: str) -> Look:
-    """A method's look: its own if :data:`METHODS` names it, else a spare one chosen by a stable
-    hash of its name (a user's own method looks the same on every figure and every run)."""
-    return METHODS.get(method) or SPARE[zlib.crc32(method.encode()) % len(SPARE)]
+def method_look(experiment: dict, method: str) -> Look:
+    """A method's look: the one it asks for (:func:`replication.display.asked_look`), else a spare one
+    chosen by a stable hash of its name, skipping those the experiment's other methods have (a user's own
+    method looks the same on every figure and every run, and unlike its neighbours)."""
+    asked = _asked(experiment, method)
+    if asked is not None:
+        return asked
+    taken = {_asked(experiment, other) for other in experiment.get("methods", {}) if other != method}
+    start = zlib.crc32(method.encode())
+    return next(look for look in (SPARE[(start + i) % len(SPARE)] for i in range(len(SPARE))) if look not in taken)
 
 
-def method_label(experiment: dict, method: str) -> str:
-    """A method's name in legends: its config's ``label``, else its key."""
-    return experiment["methods"].get(method, {}).get("label", method)
+def _asked(experiment: dict, method: str) -> Look | None:
+    params = experiment.get("methods", {}).get(method) or {}
+    try:
+        declared = getattr(builder(params["filter"]), "look", None) if "filter" in params else None
+    except ConfigError:  # its filter does not import here (a plugin not installed): its own look: alone
+        declared = None
+    return asked_look(params, declared, f"experiment.methods.{method}.look")
 
 
 def shades(colour: str, n: int) -> list[tuple]:

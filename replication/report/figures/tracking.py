@@ -8,12 +8,13 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import to_rgb
 
+from replication.boxes import centres
+from replication.display import method_label
 from replication.evidence.aggregate import scene_of, sequence_seen
 from replication.evidence.attributes import absent, attribute_scores
 from replication.metrics import multi
-from replication.metrics.tracking import centres
 from replication.report.figures.style import (
-    NothingToDraw, axis_label, clipped_note, method_label, method_look, save,
+    NothingToDraw, axis_label, clipped_note, method_look, save,
 )
 from replication.report.figures.base import figure
 
@@ -38,7 +39,7 @@ def per_frame_curve(bands: pd.DataFrame, spec: dict, experiment: dict, path: Pat
     fig, axes = plt.subplots(len(groups), 1, figsize=(7, 2.6 * len(groups)), squeeze=False)
     for ax, (condition, group) in zip(axes[:, 0], groups):
         for method, band in group.groupby("method", sort=False):
-            frames, look = band["frame"].to_numpy(), method_look(method)
+            frames, look = band["frame"].to_numpy(), method_look(experiment, method)
             ax.plot(frames, band["mean"], **look.line(), markevery=max(1, len(frames) // 12),
                     markersize=4, lw=1.2,
                     label=method_label(experiment, method)
@@ -75,7 +76,7 @@ def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Pa
             ax.plot(frames, centre[..., axis], color="k", lw=2, alpha=0.35)[0].set_label("truth")
             for _, run in _first_runs(group).iterrows():
                 boxes = np.array(run["per_frame"]["box"])
-                look = method_look(run["method"])
+                look = method_look(experiment, run["method"])
                 lines = ax.plot(frames, boxes[..., axis] + boxes[..., axis + 2] / 2, color=look.colour,
                                 linestyle=look.linestyle, lw=1)
                 lines[0].set_label(method_label(experiment, run["method"]))
@@ -108,7 +109,7 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
         frames = _frames(spec, scene_of(experiment, group), sequence.n_frames)
         runs = list(_first_runs(group).iterrows())
         grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k,
-                           method_look(run["method"]).colour) for _, run in runs] for k in frames]
+                           method_look(experiment, run["method"]).colour) for _, run in runs] for k in frames]
         labels = [method_label(experiment, run["method"]) for _, run in runs]
         if spec.get("rows") != "frames":
             grid = [list(column) for column in zip(*grid)]
@@ -161,9 +162,9 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         axis = "xy".index(run["strip"]["axis"])
         ax.imshow(density.T, origin="lower", aspect="auto", cmap="magma",
                   extent=(1, density.shape[0], 0, sequence.size[axis]))
-        centres = sequence.truth[1:, :, axis] + sequence.truth[1:, :, axis + 2] / 2
-        for m in range(centres.shape[1]):
-            ax.plot(np.arange(1, len(centres) + 1), centres[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
+        truth = centres(sequence.truth[1:])[..., axis]
+        for m in range(truth.shape[1]):
+            ax.plot(np.arange(1, len(truth) + 1), truth[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
         first, last = spec.get("window", (None, None))
         if first is not None:
             ax.axvspan(first, last, color="w", alpha=0.08)
@@ -186,8 +187,8 @@ def otb_curves(curves: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     for ax, name, every in ((axes[0], "precision", 5), (axes[1], "success", 3)):
         for method, line in curves[curves["curve"] == name].groupby("method", sort=False):
-            ax.plot(line["threshold"], line["value"], **method_look(method).line(), markevery=every, markersize=4,
-                    label=f"{method_label(experiment, method)} [{line['score'].iloc[0]:.3f}]")
+            ax.plot(line["threshold"], line["value"], **method_look(experiment, method).line(), markevery=every,
+                    markersize=4, label=f"{method_label(experiment, method)} [{line['score'].iloc[0]:.3f}]")
     axes[0].set(xlabel="location error threshold (px)", ylabel="precision", title="Precision plot (OPE)")
     axes[1].set(xlabel="overlap threshold", ylabel="success rate", title="Success plot (OPE)")
     for ax in axes:
@@ -290,7 +291,7 @@ def outside_curve(shares: pd.DataFrame, spec: dict, experiment: dict, path: Path
     tracker that runs off the frame shows it here."""
     fig, ax = plt.subplots(figsize=(7, 2.8))
     for method, share in shares.groupby("method", sort=False):
-        ax.plot(share["frame"], share["share"], **method_look(method).line(),
+        ax.plot(share["frame"], share["share"], **method_look(experiment, method).line(),
                 markevery=max(1, len(share) // 12), markersize=4, lw=1.2, label=method_label(experiment, method))
     ax.set_xlabel("frame")
     ax.set_ylabel("share of estimates\noutside the image")

@@ -24,7 +24,7 @@ from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
-from replication.scenes.factory import cached_sequence
+from replication.scenes.factory import cached_sequence, scene_kind
 from replication.runner.results import Results
 from replication.runner.variant import SHOWN
 
@@ -115,20 +115,17 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     return page
 
 
-REAL = {"otb": "OTB", "mot": "MOTChallenge"}  # scene kinds that are real video, by their benchmark
-
-
 def _scenes(experiment: dict, written: dict) -> list[dict]:
     """What each scene of a tracking experiment is: real video, or a synthetic stand-in and for what; for a
     stand-in whose length depends on the scale, whether the quick video is the start of the paper's."""
     rows = []
     for name, spec in experiment.get("scenes", {}).items():
-        kind = spec.get("kind", "synthetic")
-        if kind in REAL:
-            first = spec.get("first", 0) + (kind == "otb")  # OTB's first is 0-based, MOTChallenge's 1-based
+        kind = scene_kind(spec)
+        if kind.real:
+            first = spec.get("first", kind.counts_from) - kind.counts_from + 1  # counted from 1, as people do
             frames = f"frames {first}-{spec['last']}" if spec.get("last") else "all frames"
-            rows.append({"name": name, "kind": f"real video ({REAL[kind]})",
-                         "what": f"{REAL[kind]} sequence {spec['name']}, {frames}"})
+            rows.append({"name": name, "kind": f"real video ({kind.benchmark})",
+                         "what": f"{kind.benchmark} sequence {spec['name']}, {frames}"})
         else:
             size = "x".join(str(v) for v in spec.get("size", []))
             what = spec.get("stand_in") or "synthetic scene"
