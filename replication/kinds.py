@@ -46,7 +46,7 @@ class Registry(Generic[T]):
         self._kinds = None
 
     def __getitem__(self, name: str) -> T:
-        known = self._kinds if self._kinds is not None else self._known()  # looked up at a filter's every step
+        known = self._known()
         try:
             return known[name]
         except (KeyError, TypeError):  # TypeError: not a name at all (a list or mapping from YAML)
