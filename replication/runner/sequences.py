@@ -80,4 +80,3 @@ def follow_sequences(report: dict, replaced: set[str], scenes: list[str]) -> dic
 
     return {**report, **{part: [moved(spec) for spec in report.get(part, [])] for part in ("tables", "figures")
                          if part in report}}
-
