@@ -373,7 +373,8 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     partial = write([cfg], tmp_path / "store", tmp_path / "partial").experiments["hspf_test_readings"]
     assert list(partial.files) == ["hspf_test_readings/universes/default.parquet"]
     # the command goes on where a record stops: a universe recorded under this code's keys is not run again
-    from replication.cli import multiverse_forecast, recorded_universes
+    from replication.cli import multiverse_forecast
+    from replication.record.layer import recorded_universes
 
     assert not record.universe(multiverse.name, larger.name).holds(multiverse.runs["default", "hspf_ungm"])
     for folder, scale, skip, expected in (("partial", "paper", True, ["default"]), ("record", "paper", True,

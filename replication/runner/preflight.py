@@ -62,7 +62,7 @@ def check_settings(cfg: DictConfig) -> None:
         raise ConfigError(f"n_jobs must be a positive number of workers or -1 for all cores, got {n_jobs!r}")
     if cfg.get("scale") not in SCALES:
         raise ConfigError(f"scale must be one of {', '.join(SCALES)}, got {cfg.get('scale')!r}")
-    for flag in ("outside_project", "skip_recorded"):
+    for flag in ("outside_project", "skip_recorded", "dry_run"):
         if not isinstance(cfg.get(flag), bool):
             raise ConfigError(f"{flag} must be true or false, got {cfg.get(flag)!r}")
     claims = cfg.get("claims_dir")

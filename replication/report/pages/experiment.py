@@ -22,6 +22,7 @@ from replication.evidence.published import cells, load_published, published_path
 from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
+from replication.scales import report_folder
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
 from replication.scenes.factory import cached_sequence
@@ -30,9 +31,10 @@ from replication.runner.variant import SHOWN
 
 
 def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
-    """Write ``<reports>/<experiment>/`` from an experiment's stored ``results``; return the page's path."""
+    """Write ``<reports>/<experiment>/`` (at the quick scale ``<reports>/quick/<experiment>/``) from an
+    experiment's stored ``results``; return the page's path."""
     experiment, runs, records, failures = results.experiment, results.runs, results.records, results.failures
-    out = resolve(cfg.reports) / results.name
+    out = report_folder(resolve(cfg.reports), results.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
     spec = experiment.get("report", {})
