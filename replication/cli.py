@@ -171,8 +171,8 @@ def run_experiment(cfg: DictConfig) -> None:
         print(f"skipped: {message}", file=sys.stderr)
     store = Store(resolve(cfg.store), cfg.experiment.name)
     held = beneath(cfg, runs, store)  # at paper scale, the record's runs beneath the store
-    if missing(cfg):
-        print(missing(cfg), file=sys.stderr)
+    if note := missing(cfg):
+        print(note, file=sys.stderr)
     if cfg.dry_run:
         plan(cfg, runs, held, n_jobs)
         if reported_as == cfg.experiment.name:  # as a run does: a changed experiment runs without its companions
@@ -181,9 +181,9 @@ def run_experiment(cfg: DictConfig) -> None:
     if held.recorded:
         print(said(cfg.experiment.name, [held], len(runs)), flush=True)
     try:
-        done = execute(held.computed(runs), store, n_jobs=n_jobs, backend=backend, progress=cfg.progress,
-                       address=address)
-        stored = len(held.computed(runs)) - done
+        computed = held.computed(runs)
+        done = execute(computed, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
+        stored = len(computed) - done
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
               + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
         from replication.report.pages.experiment import write_experiment_report
@@ -248,12 +248,16 @@ def run_multiverse(cfg: DictConfig) -> None:
           f"{distinct} distinct runs")
     store, runs = None, None
     recorded, layers = universes_beneath(cfg, multiverse)
-    if missing(cfg):
-        print(missing(cfg), file=sys.stderr)
-    if said(name, list(layers.values()), distinct):
-        print(said(name, list(layers.values()), distinct), flush=True)
+    if note := missing(cfg):
+        print(note, file=sys.stderr)
+    if (read := said(name, list(layers.values()), distinct)) and not cfg.dry_run:
+        print(read, flush=True)
     print(multiverse_forecast(cfg, multiverse, recorded, n_jobs, layers), flush=True)
     if cfg.dry_run:
+        counted = ", ".join(f"{len(runs):,} {where}" for where, runs in universes_left(cfg, multiverse, recorded,
+                                                                                        layers).items())
+        print(f"{name}: {len(recorded)} of {len(multiverse.universes)} universes read whole from the record; of "
+              f"the others' runs {counted}")
         print(f"{name}: a dry run: nothing computed or written (without dry_run=true this request runs)")
         return
     try:
@@ -274,6 +278,7 @@ def run_multiverse(cfg: DictConfig) -> None:
 
         from replication.report.pages.index import write_index
         from replication.report.pages.multiverse import write_multiverse_report
+
         written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task),
                                           reader(recorded, layers))
         index = write_index(resolve(cfg.reports), cfg.published_values)
@@ -294,16 +299,8 @@ def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int
 
     from replication.record.runs import Record
     from replication.runner.execute import duration
-    from replication.runner.store import Store
 
-    stores, left = {e: Store(resolve(cfg.store), e) for e in multiverse.experiments}, {}
-    for universe in multiverse.universes:
-        for experiment, store in stores.items() if universe.name not in recorded else ():
-            # a file's presence, not its soundness (Store.has reads it): a forecast reads no records
-            layer = (layers or {}).get((universe.name, experiment))
-            left.update((run.run_id, run) for run in multiverse.runs[universe.name, experiment]
-                        if not (store.path(run).exists() or store.failure_path(run).exists()
-                                or (layer and run.run_id in layer.recorded)))
+    left = universes_left(cfg, multiverse, recorded, layers)["to compute"]
     said = f"{multiverse.name}: {len(left):,} runs to compute"
     base = [run for experiment in multiverse.experiments for run in multiverse.runs["default", experiment]]
     record = Record(resolve(cfg.record))  # the base experiments' records, else the default universe's
@@ -316,6 +313,24 @@ def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int
     unknown = f"; {len(left) - len(timed):,} with no recorded time not counted" if len(timed) < len(left) else ""
     return (f"{said}, about {duration(sum(timed) / workers)} on {workers} worker(s) (from the record's times of "
             f"the same methods and conditions{unknown})")
+
+
+def universes_left(cfg: DictConfig, multiverse, recorded: dict, layers: dict | None = None) -> dict[str, dict]:
+    """The distinct runs of the universes not read whole from the record (``recorded``), by where they are:
+    ``stored`` (a file's presence, not its soundness: a forecast reads no records), ``read from the record``
+    beneath the store (``layers``, per universe and experiment) and ``to compute``, each by experiment and run
+    id."""
+    from replication.runner.store import Store
+
+    found = {"stored": {}, "read from the record": {}, "to compute": {}}
+    for universe in multiverse.universes:
+        for experiment in multiverse.experiments if universe.name not in recorded else ():
+            store, layer = Store(resolve(cfg.store), experiment), (layers or {}).get((universe.name, experiment))
+            for run in multiverse.runs[universe.name, experiment]:
+                where = ("stored" if store.path(run).exists() or store.failure_path(run).exists() else
+                         "read from the record" if layer and run.run_id in layer.recorded else "to compute")
+                found[where][experiment, run.run_id] = run
+    return found
 
 
 def run_companions(cfg: DictConfig) -> None:

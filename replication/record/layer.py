@@ -28,7 +28,7 @@ from replication.run import Run
 from replication.runner.results import SERIES
 from replication.runner.store import CorruptRecord, Store
 
-SCALE = "paper"  # the record's
+SCALE = "paper"  # the record's scale
 
 
 class Layered:
@@ -63,6 +63,8 @@ class Layered:
         if not from_record:
             return stored
         recorded = self.record.load(from_record)
+        if stored.empty:
+            return recorded
         stored = stored.drop(columns=[s for s in SERIES if s in stored and s not in recorded])
         return pd.concat([stored, recorded], ignore_index=True)
 
@@ -72,8 +74,10 @@ class Layered:
         return self.store.failures(self.computed(runs)) + (self.record.failures(from_record) if from_record
                                                            else Counter())
 
-    def path(self, run: Run) -> Path:
-        return self.store.path(run)
+
+def reads_record(cfg: DictConfig) -> bool:
+    """Whether a request reads the record beneath the store: at the paper scale, unless ``skip_recorded=false``."""
+    return bool(cfg.get("skip_recorded")) and cfg.scale == SCALE
 
 
 def beneath(cfg: DictConfig, runs: list[Run], store: Store) -> Layered:
@@ -81,7 +85,7 @@ def beneath(cfg: DictConfig, runs: list[Run], store: Store) -> Layered:
     below the paper scale, with ``skip_recorded=false``, where there is no record, where the record's files of
     the experiment are damaged (said once, on stderr), or where it holds none of the runs as this code
     computes them."""
-    if not runs or not (cfg.get("skip_recorded") and cfg.scale == SCALE):
+    if not runs or not reads_record(cfg):
         return Layered(store)
     root, name = resolve(cfg.record), runs[0].experiment
     entry = checked(root, name)
@@ -120,7 +124,7 @@ def missing(cfg: DictConfig) -> str | None:
     """Where a paper-scale request would read the record and there is none (an installed copy), one line that
     says where one can be had; else None."""
     root = resolve(cfg.record)
-    if not (cfg.get("skip_recorded") and cfg.scale == SCALE) or (root / MANIFEST).exists():
+    if not reads_record(cfg) or (root / MANIFEST).exists():
         return None
     return (f"no record at {root}, so every paper-scale run is computed here; a clone of the project ships one in "
             "record/: record=<its path> reads it (skip_recorded=false computes all, and says nothing)")
@@ -144,7 +148,7 @@ def recorded_universes(cfg: DictConfig, multiverse) -> dict[str, Record]:
     and none where the record's files of the multiverse are damaged (:func:`checked`).  A multiverse too long
     for one sitting then goes on, on any machine, where the record stops."""
     root = resolve(cfg.record)
-    if not (cfg.get("skip_recorded") and cfg.scale == SCALE) or checked(root, multiverse.name) is None:
+    if not reads_record(cfg) or checked(root, multiverse.name) is None:
         return {}
     return Record(root).universes_held(multiverse)
 

@@ -26,7 +26,7 @@ from omegaconf import DictConfig
 from replication.errors import ConfigError
 from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.tables import TableKind
-from replication.record.layer import checked
+from replication.record.layer import SCALE, checked
 from replication.record.manifest import Entry, Manifest
 from replication.record.runs import (
     CURVES_DIR, RUNS_FILE, UNIVERSE, Record, read_rows, row, runs_table, universe_path, write_table,
@@ -36,7 +36,6 @@ from replication.runner.config import expand, experiment_at_scale
 from replication.runner.multiverse import load
 from replication.runner.store import CorruptRecord, Store
 
-SCALE = "paper"
 
 
 def kept_series(experiment: dict) -> tuple[str, ...]:
