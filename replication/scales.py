@@ -38,3 +38,8 @@ def report_folder(reports: str | Path, name: str, scale: str) -> Path:
     """Where report ``name`` at ``scale`` lives: ``<reports>/<name>/`` at the paper scale, ``<reports>/quick/<name>/``
     at the quick one."""
     return Path(reports) / name if scale == "paper" else Path(reports) / QUICK_REPORTS / name
+
+
+def index_from(name: str, scale: str) -> str:
+    """The reports' index (``<reports>/index.html``) as a link from the page of report ``name`` at ``scale``."""
+    return "../" * len(report_folder("", name, scale).parts) + "index.html"

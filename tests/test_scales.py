@@ -17,7 +17,7 @@ from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.results import Results
 from replication.runner.store import Store
-from replication.scales import SCALES, default_scale, report_folder
+from replication.scales import SCALES, default_scale, index_from, report_folder
 
 
 def test_the_default_scale_is_quick_and_every_place_says_so():
@@ -41,6 +41,9 @@ def test_both_scales_pages_stay_and_the_scorecard_names_each_verdicts_scale(make
     paper, quick = (Summary.read(report_folder(reports, "hspf_ungm", scale) / "summary.json") for scale in SCALES)
     assert (paper.scale, paper.n_runs, quick.scale, quick.n_runs) == ("paper", 15, "quick", 6)
     assert report_folder(reports, "hspf_ungm", "quick") == reports / "quick" / "hspf_ungm"
+    for scale in SCALES:  # each page links back to the one index
+        page, home = report_folder(reports, "hspf_ungm", scale) / "index.html", index_from("hspf_ungm", scale)
+        assert f'href="{home}"' in page.read_text() and (page.parent / home).resolve() == reports / "index.html"
 
     def scorecard() -> tuple[str, str, str]:
         index = write_index(reports).read_text()

@@ -27,7 +27,7 @@ from replication.evidence.statistics import said_level
 from replication.paths import resolve
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
-from replication.scales import report_folder
+from replication.scales import index_from, report_folder
 from replication.report.figures.style import OUTCOME_COLOURS
 from replication.evidence.tables import TableKind
 from replication.runner.multiverse import Multiverse
@@ -134,6 +134,7 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
     page.write_text(render(
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
         robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
+        home=index_from(multiverse.name, cfg.scale),
         scale_note=scale_note(cfg.scale), config=OmegaConf.to_yaml(cfg.experiment),
         command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
