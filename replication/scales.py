@@ -40,6 +40,11 @@ def report_folder(reports: str | Path, name: str, scale: str) -> Path:
     return Path(reports) / name if scale == "paper" else Path(reports) / QUICK_REPORTS / name
 
 
+def page_link(name: str, scale: str) -> str:
+    """The page of report ``name`` at ``scale`` as a link from the reports' folder (the index's)."""
+    return f"{report_folder('', name, scale).as_posix()}/index.html"
+
+
 def index_from(name: str, scale: str) -> str:
     """The reports' index (``<reports>/index.html``) as a link from the page of report ``name`` at ``scale``."""
     return "../" * len(report_folder("", name, scale).parts) + "index.html"

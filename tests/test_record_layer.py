@@ -58,7 +58,8 @@ def test_the_runs_the_record_holds_are_read_from_it_and_only_the_rest_computed(m
         assert not beneath(other, expand(other), store).recorded, off
     nowhere = make_cfg("hspf_ungm", *UNGM, f"record={tmp_path / 'nowhere'}")  # an installed copy: no record
     assert not beneath(nowhere, runs, store).recorded
-    assert missing(nowhere).startswith(f"no record at {tmp_path / 'nowhere'}") and "record=<its path>" in missing(nowhere)
+    said_missing = missing(nowhere)
+    assert said_missing.startswith(f"no record at {tmp_path / 'nowhere'}") and "record=<its path>" in said_missing
     assert missing(cfg) is None
     path = tmp_path / "record" / "hspf_ungm" / "runs.parquet"  # a damaged record is not read, and said once
     path.write_bytes(path.read_bytes() + b"\0")

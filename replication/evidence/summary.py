@@ -21,7 +21,7 @@ import yaml
 from replication.evidence.schema import Summary
 from replication.evidence.tables import KEYS, CellResult, matched
 from replication.paths import CONF_DIR, experiment_names
-from replication.scales import SCALES, report_folder
+from replication.scales import SCALES, page_link, report_folder
 
 # -- the summary of every published cell --------------------------------------------------------------
 
@@ -112,7 +112,7 @@ def summary_table(
             if entry.our_condition != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
                 row["our_condition"] = entry.our_condition
             row["runs"] = str(entry.runs)
-            row["link"] = f"{_page(name, summaries)}#{entry.table_name}"
+            row["link"] = f"{page_link(name, summaries[name].scale)}#{entry.table_name}"
             row["link_text"] = f"{name}: {entry.table_name}"
             row["also"] = "; ".join(
                 f"{e.table_name}{' ' + e.our_condition if e.our_condition else ''}: {e.ours}, {_verdict(e)[1]}"
@@ -121,18 +121,13 @@ def summary_table(
         else:
             unmatched, name = _why_not(cell, summaries, configs, scene_notes)
             row["reason"], row["reason_kind"] = str(unmatched), unmatched.kind
-            row["link"] = f"{_page(name, summaries)}#unmatched" if name in summaries else ""
+            row["link"] = f"{page_link(name, summaries[name].scale)}#unmatched" if name in summaries else ""
             row["link_text"] = name if name in summaries else ""
         rows.append(row)
     columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "tag", "reason",
                "reason_kind",
                "also", "claim", "link", "link_text"]
     return pd.DataFrame(rows, columns=columns)
-
-
-def _page(name: str, summaries: dict[str, Summary]) -> str:
-    """The page of ``name``'s report, relative to the reports' folder (at its summary's scale)."""
-    return f"{report_folder('', name, summaries[name].scale).as_posix()}/index.html"
 
 
 def counts(table: pd.DataFrame, summaries: dict[str, Summary] | None = None) -> dict:

@@ -37,7 +37,6 @@ from replication.runner.multiverse import load
 from replication.runner.store import CorruptRecord, Store
 
 
-
 def kept_series(experiment: dict) -> tuple[str, ...]:
     """The per-frame series the experiment's tables are built from: the record keeps those alone."""
     tables = experiment.get("report", {}).get("tables", [])

@@ -22,7 +22,7 @@ from replication.report.pages import glance
 from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
-from replication.scales import QUICK_REPORTS, SCALES, report_folder
+from replication.scales import QUICK_REPORTS, SCALES, page_link
 from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
 from replication.evidence.schema import Summary
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table
@@ -42,15 +42,10 @@ def _scale_note(summaries: dict[str, Summary]) -> str | None:
             f"quick changes for it.")
 
 
-def _link(summary: Summary) -> str:
-    """The page of a report, relative to the reports' folder."""
-    return f"{report_folder('', summary.name, summary.scale).as_posix()}/index.html"
-
-
 def _entry(name: str, summary: Summary) -> dict:
     """A report's row in the index's tables of experiments."""
-    return {"name": name, "link": _link(summary), "title": summary.title, "paper": summary.paper,
-            "scale": summary.scale,
+    return {"name": name, "link": page_link(summary.name, summary.scale), "title": summary.title,
+            "paper": summary.paper, "scale": summary.scale,
             "n_records": summary.n_records, "n_runs": summary.n_runs, "failed": summary.failed,
             "verdicts": ", ".join(f"{k}: {v}" for k, v in sorted(summary.verdicts.items())) or "-",
             "ablation": "ablation" in name,  # the studies on top of the papers get their own section
@@ -99,7 +94,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
                      "cells": int((cells["paper"] == paper.key).sum()), "findings": _findings(reports, paper.key)}
                     for paper in papers],
             scale_note=_scale_note(summaries),
-            links={name: _link(summary) for name, summary in summaries.items()},  # the scorecard's evidence
+            links={name: page_link(s.name, s.scale) for name, s in summaries.items()},  # the scorecard's evidence
             record=record,
             tallies=tallies,
             rules=rules(),

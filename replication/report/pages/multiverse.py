@@ -116,9 +116,10 @@ def _headline(robustness: Robustness) -> str | None:
 
 def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
                             store_of=None) -> Path:
-    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``): the choices, the universes run, each claim's robustness with every
-    case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard.  ``store_of(experiment,
-    universe)`` holds the runs (the store by default; the paper-scale record's universe)."""
+    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``): the choices, the universes
+    run, each claim's robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for
+    the scorecard.  ``store_of(experiment, universe)`` holds the runs (the store by default; the paper-scale
+    record's universe, or the record beneath the store: :mod:`replication.record.layer`)."""
     out = report_folder(resolve(cfg.reports), multiverse.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
