@@ -64,8 +64,9 @@ test-all: setup browser
 # One Hydra multirun over every experiment: one process and one pool of workers for all of them,
 # instead of starting Python, numba and the workers again per experiment (about two minutes at quick scale).
 # The shipped record's pages first (the verdicts at the papers' scale, in about a minute), then this
-# machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the
-# record is rewritten from the runs just made (a file whose runs did not change keeps its bytes).
+# machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the runs the
+# record holds as this code computes them are read from it, not computed (skip_recorded=false in conf/config.yaml
+# computes all), and the record is rewritten with the runs just made (a file whose runs did not change keeps its bytes).
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)

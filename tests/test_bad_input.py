@@ -58,12 +58,15 @@ def assert_one_line(result, tmp_path, named):
         (("experiment=demo_scene", "experiment.model.motion.step_sd=[4,-4,0.5,0.5]"), "must not be negative"),
         (("experiment=hspf_ungm", "experiment.runs.quick=2.5"), "experiment.runs.quick"),
         # measured against the file's 100, not against the overridden count itself
-        (("experiment=hspf_ungm", "experiment.runs.paper=5000"), "= 5,000 runs per condition, against the paper's 100"),
+        (("experiment=hspf_ungm", "scale=paper", "experiment.runs.paper=5000"),
+         "= 5,000 runs per condition, against the paper's 100"),
         (("experiment=hspf_ungm", "experiment.name=../../../x"), "experiment.name"),
         (("experiment=hspf_ungm", "experiment.name=a/b"), "experiment.name"),
         (("experiment=hspf_ungm", "experiment.methods=[1,2]"), "experiment.methods=[1,2]"),
         (("experiment=hspf_ungm", "outside_project=maybe"), "outside_project"),
         (("experiment=hspf_ungm", "skip_recorded=1"), "skip_recorded must be true or false"),
+        (("experiment=hspf_ungm", "dry_run=yes"), "dry_run must be true or false"),
+        (("experiment=hspf_ungm", "record=null"), "record must be a folder"),
     ],
 )
 def test_config_errors_are_one_line_before_any_heavy_import(tmp_path, args, named):
@@ -215,11 +218,11 @@ def test_a_users_own_sequences_get_their_own_report_and_leave_the_scorecard_alon
     records = list((tmp_path / "experiments" / "hspf" / "runs").glob("*.json"))
     assert records and all("scene=MyClip" in r.read_text() for r in records)
     assert (tmp_path / "reports" / "claims.csv").read_bytes() == before
-    assert not (tmp_path / "reports" / "hspf").exists() and not (tmp_path / "reports" / "hspf_ungm").exists()
+    assert not {"hspf", "hspf_ungm"} & {p.name for p in (tmp_path / "reports").rglob("*") if p.is_dir()}
     assert "skipped: hspf_ungm" in result.stderr
-    page = (tmp_path / "reports" / "hspf@mine" / "index.html").read_text()
+    page = (tmp_path / "reports" / "quick" / "hspf@mine" / "index.html").read_text()
     assert "Not the paper's experiment" in page and "scenes.MyClip: added" in page and "sequences=[MyClip]" in page
-    assert 'href="hspf@mine/index.html"' in (tmp_path / "reports" / "index.html").read_text()
+    assert 'href="quick/hspf@mine/index.html"' in (tmp_path / "reports" / "index.html").read_text()
 
 
 @pytest.mark.parametrize(
@@ -262,10 +265,10 @@ def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_a
     assert result.returncode == 0, result.stderr
     assert "reported as bis_pf_pets@campus" in result.stdout
     assert (tmp_path / "reports" / "claims.csv").read_bytes() == before
-    page = (tmp_path / "reports" / "bis_pf_pets@campus" / "index.html").read_text()
+    page = (tmp_path / "reports" / "quick" / "bis_pf_pets@campus" / "index.html").read_text()
     assert "Not the paper&#39;s experiment" in page or "Not the paper's experiment" in page
     assert 'scenes.exp6_pets09.name: &#34;PETS09-S2L1&#34; -&gt; &#34;TUD-Campus&#34;' in page
-    assert not (tmp_path / "reports" / "bis_pf_pets").exists()
+    assert not (tmp_path / "reports" / "quick" / "bis_pf_pets").exists()
 
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
@@ -286,7 +289,7 @@ def test_sequences_of_ones_own_run_through_a_mot_experiment_and_its_figures_foll
     assert result.returncode == 0, result.stderr
     records = list((tmp_path / "experiments" / "bis_pf_pets" / "runs").glob("*.json"))
     assert records and all("scene=MyCampus" in r.read_text() for r in records)
-    folder = tmp_path / "reports" / "bis_pf_pets@mine"
+    folder = tmp_path / "reports" / "quick" / "bis_pf_pets@mine"
     assert (folder / "snapshots.png").stat().st_size > 10_000 and (folder / "identities.png").exists()
     sequence_page = (folder / "sequences" / "MyCampus.html").read_text()  # a page of its own, its figures on it
     assert 'href="sequences/MyCampus.html"' in (folder / "index.html").read_text()

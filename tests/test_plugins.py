@@ -204,9 +204,9 @@ def test_the_tutorial_runs_the_sixth_paper_and_judges_it_with_the_package_untouc
     assert done.returncode == 0, done.stderr[-3000:]
     reports = project / "reports"
     for name in ("hspf_ungm@apf", "hspf@apf"):
-        page = (reports / name / "index.html").read_text()
+        page = (reports / "quick" / name / "index.html").read_text()
         assert "APF" in page, name
-    own = [p for p in reports.glob("apf_ungm@*") if p.is_dir()]
+    own = [p for p in (reports / "quick").glob("apf_ungm@*") if p.is_dir()]
     assert len(own) == 1
     import json
 

@@ -373,7 +373,8 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     partial = write([cfg], tmp_path / "store", tmp_path / "partial").experiments["hspf_test_readings"]
     assert list(partial.files) == ["hspf_test_readings/universes/default.parquet"]
     # the command goes on where a record stops: a universe recorded under this code's keys is not run again
-    from replication.cli import multiverse_forecast, recorded_universes
+    from replication.cli import multiverse_forecast, universes_left
+    from replication.record.layer import recorded_universes
 
     assert not record.universe(multiverse.name, larger.name).holds(multiverse.runs["default", "hspf_ungm"])
     for folder, scale, skip, expected in (("partial", "paper", True, ["default"]), ("record", "paper", True,
@@ -385,5 +386,8 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     cfg.record, cfg.scale, cfg.skip_recorded = str(tmp_path / "partial"), "paper", True
     said = multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2)
     assert said.startswith("hspf_test_readings: 1 runs to compute, about ") and "1 worker(s)" in said, said
+    left = universes_left(cfg, multiverse, recorded_universes(cfg, multiverse))  # what dry_run=true counts
+    assert {where: len(runs) for where, runs in left.items()} == {
+        "stored": len(larger_runs) - 1, "read from the record": 0, "to compute": 1}
     cfg.record = str(tmp_path / "record")
     assert multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2).endswith(": 0 runs to compute")

@@ -284,7 +284,7 @@ def test_cli_end_to_end_writes_report(cli, tmp_path):
     result = cli("experiment=gps_qmcpf", "experiment.also=[]", *SMALL)  # not its helicopter half
     assert result.returncode == 0, result.stderr
     assert "48 runs computed, 0 already stored" in result.stdout
-    out = tmp_path / "reports" / "gps_qmcpf"
+    out = tmp_path / "reports" / "quick" / "gps_qmcpf"  # the quick scale's page, apart from the paper scale's
     table = pd.read_csv(out / "table1_rmse.csv")
     assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100"] * 5 + ["-"]
     assert np.all(table["runs"] == 3)
@@ -331,7 +331,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
     )
     assert report.returncode == 0, report.stderr
     assert "n_points=3201: 3 of 9 runs not stored" in report.stderr  # a value never run is named, not drawn
-    (out,) = (tmp_path / "reports").glob("ungm_horizon@*/sweeps")  # T=10 only: not the experiment as shipped
+    (out,) = (tmp_path / "reports" / "quick").glob("ungm_horizon@*/sweeps")  # T=10 only: not as shipped
     table = pd.read_csv(out / "experiment.methods.grid.n_points.csv").set_index("condition")
     records = pd.DataFrame([json.loads(p.read_text()) for p in (tmp_path / "experiments" / "ungm_horizon" / "runs").glob("*.json")])
     grid = records[records["method"] == "grid"]  # two configs, 3 runs each
@@ -353,7 +353,7 @@ def test_a_multirun_draws_its_sweep_at_its_end(cli, tmp_path):
     result = cli("-m", "experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=5", "experiment.methods.grid.n_points=201",
                  "experiment.methods.PF.n_particles=50,100")
     assert result.returncode == 0, result.stderr
-    (sweeps,) = (tmp_path / "reports").glob("hspf_ungm@*/sweeps")  # its grid of 201 points: not as shipped
+    (sweeps,) = (tmp_path / "reports" / "quick").glob("hspf_ungm@*/sweeps")  # a grid of 201 points: not as shipped
     page = sweeps / "experiment.methods.PF.n_particles.html"
     assert page.exists() and "sweep: " in result.stdout
     table = pd.read_csv(page.with_suffix(".csv"))

@@ -66,6 +66,11 @@ class Entry:
         first, last = (datetime.datetime.fromisoformat(t) for t in (self.first_computed, self.last_computed))
         return round((last - first).total_seconds() / 60, 1)
 
+    def damaged(self, record: Path) -> list[str]:
+        """Its files whose bytes no longer have the SHA-256 it gives them (or that are gone)."""
+        return [file for file, digest in self.files.items()
+                if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
+
     def replacing(self, earlier: "Entry") -> "Entry":
         """This entry, keeping what ``earlier`` (the recording it replaces) took."""
         return replace(self, before=Before(earlier.commits, earlier.code_digests, earlier.runs, earlier.wall_s,
@@ -126,8 +131,7 @@ class Manifest:
 
     def damaged(self, record: Path) -> list[str]:
         """The files whose bytes no longer have the manifest's SHA-256 (or that are gone)."""
-        return [file for entry in self.experiments.values() for file, digest in entry.files.items()
-                if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
+        return [file for entry in self.experiments.values() for file in entry.damaged(record)]
 
 
 def read_profile(record: Path) -> dict | None:

@@ -1,5 +1,6 @@
-"""``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true] [source=record]``:
-rebuild reports from stored runs only.
+"""``python -m replication.report [scale=quick|paper] [experiment=a,b] [pdf=false] [screenshot=true] [source=record]``:
+rebuild reports from stored runs only (at the default scale, quick, unless ``scale=`` says otherwise; at the
+paper scale, with the record's runs beneath the store's as a run reads them: :mod:`replication.record.layer`).
 
 ``source=record`` draws the paper-scale record's reports instead (:mod:`replication.record`: every
 experiment it holds, at the paper scale, into ``<reports>/record/``): tables, verdicts and the figures
@@ -28,6 +29,7 @@ from replication.evidence.published import published_path
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
+from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
@@ -40,6 +42,7 @@ from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
 from replication.runner.results import Results
 from replication.runner.store import Store
+from replication.scales import report_folder
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
 SCREENSHOT = "screenshot.png"
@@ -145,14 +148,17 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
             return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
                                    for u in multiverse.universes for e in multiverse.experiments), \
                 len(multiverse.universes)
-        if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
-            multiverse = load_multiverse(cfg)
-            return name, write_multiverse_report(cfg, multiverse, tuple(overrides)), None, 0
+        if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs (at paper scale,
+            multiverse = load_multiverse(cfg)  # the record's beneath them, as the run read them)
+            return name, write_multiverse_report(cfg, multiverse, tuple(overrides),
+                                                 reader(*universes_beneath(cfg, multiverse))), None, 0
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
             return name, write_experiment_report(cfg, results), len(store.stale(results.runs)), 0
-        results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
+        runs = expand(cfg)
+        held = beneath(cfg, runs, Store(resolve(cfg.store), name))  # at paper scale, as the run read them
+        results = Results.of(cfg, runs, held, tuple(overrides), held.curves)
         return name, write_experiment_report(cfg, results), None, 0
 
 
@@ -234,7 +240,8 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
                                + ([f"metric={metric}"] if metric else []))
             results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
-                                      resolve(cfg.reports) / results.name / "sweeps", missing, command)
+                                      report_folder(resolve(cfg.reports), results.name, cfg.scale) / "sweeps",
+                                      missing, command)
             write_experiment_report(cfg, results)  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])

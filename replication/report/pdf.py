@@ -40,6 +40,7 @@ from replication.evidence.schema import Summary  # noqa: E402
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.evidence.tables import Table  # noqa: E402
 from replication.evidence.settings import rules  # noqa: E402
+from replication.scales import report_folder  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
 FONT = 7.0  # table text, points: the smallest that reads in print (a long cell wraps rather than shrinks)
@@ -83,12 +84,13 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
                      "matched it, otherwise why not")
         for name, summary in summaries.items():
             heading = summary.title
-            for table in [t for t in summary.tables if (reports / name / t["csv"]).exists()]:
-                frame = _shown(pd.read_csv(reports / name / table["csv"]))
+            folder = report_folder(reports, name, summary.scale)
+            for table in [t for t in summary.tables if (folder / t["csv"]).exists()]:
+                frame = _shown(pd.read_csv(folder / table["csv"]))
                 subtitle = " ".join(filter(None, [table["title"], table.get("note")]))
                 _table_pages(pdf, heading, frame, subtitle=subtitle, font=TABLE_FONT)
-            for figure in [f for f in summary.figures if (reports / name / f["file"]).exists()]:
-                _figure_page(pdf, heading, figure["title"], reports / name / figure["file"])
+            for figure in [f for f in summary.figures if (folder / f["file"]).exists()]:
+                _figure_page(pdf, heading, figure["title"], folder / figure["file"])
         info = pdf.infodict()
         info["Title"] = TITLE
         info["Subject"] = "The papers' published values against ours, with 95% intervals"

@@ -62,9 +62,12 @@ def check_settings(cfg: DictConfig) -> None:
         raise ConfigError(f"n_jobs must be a positive number of workers or -1 for all cores, got {n_jobs!r}")
     if cfg.get("scale") not in SCALES:
         raise ConfigError(f"scale must be one of {', '.join(SCALES)}, got {cfg.get('scale')!r}")
-    for flag in ("outside_project", "skip_recorded"):
+    for flag in ("outside_project", "skip_recorded", "dry_run"):
         if not isinstance(cfg.get(flag), bool):
             raise ConfigError(f"{flag} must be true or false, got {cfg.get(flag)!r}")
+    record = cfg.get("record")
+    if not isinstance(record, str) or not record:
+        raise ConfigError(f"record must be a folder (a clone's record/), got {record!r}")
     claims = cfg.get("claims_dir")
     if claims is not None and (not isinstance(claims, str) or not resolve(claims).is_dir()):
         raise ConfigError(f"claims_dir must be a folder of your claims files (*.yaml), got {claims!r}")

@@ -22,6 +22,7 @@ from replication.evidence.published import cells, load_published, published_path
 from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
+from replication.scales import index_from, report_folder
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
 from replication.scenes.factory import cached_sequence
@@ -30,9 +31,10 @@ from replication.runner.variant import SHOWN
 
 
 def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
-    """Write ``<reports>/<experiment>/`` from an experiment's stored ``results``; return the page's path."""
+    """Write ``<reports>/<experiment>/`` (at the quick scale ``<reports>/quick/<experiment>/``) from an
+    experiment's stored ``results``; return the page's path."""
     experiment, runs, records, failures = results.experiment, results.runs, results.records, results.failures
-    out = resolve(cfg.reports) / results.name
+    out = report_folder(resolve(cfg.reports), results.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
     spec = experiment.get("report", {})
@@ -99,6 +101,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
             scale_note=scale_note(cfg.scale, changes),
             provenance=_provenance(records),
             name=results.name,
+            home=index_from(results.name, cfg.scale),  # the reports' index, from this page's folder
             changes=results.changes[:SHOWN],
             more_changes=max(len(results.changes) - SHOWN, 0),
             sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),

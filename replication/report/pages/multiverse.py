@@ -27,6 +27,7 @@ from replication.evidence.statistics import said_level
 from replication.paths import resolve
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
+from replication.scales import index_from, report_folder
 from replication.report.figures.style import OUTCOME_COLOURS
 from replication.evidence.tables import TableKind
 from replication.runner.multiverse import Multiverse
@@ -115,10 +116,11 @@ def _headline(robustness: Robustness) -> str | None:
 
 def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
                             store_of=None) -> Path:
-    """``<reports>/<paper>_readings/``: the choices, the universes run, each claim's robustness with every
-    case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard.  ``store_of(experiment,
-    universe)`` holds the runs (the store by default; the paper-scale record's universe)."""
-    out = resolve(cfg.reports) / multiverse.name
+    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``): the choices, the universes
+    run, each claim's robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for
+    the scorecard.  ``store_of(experiment, universe)`` holds the runs (the store by default; the paper-scale
+    record's universe, or the record beneath the store: :mod:`replication.record.layer`)."""
+    out = report_folder(resolve(cfg.reports), multiverse.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
     store_of = store_of or (lambda name, universe: Store(resolve(cfg.store), name))
@@ -133,6 +135,7 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
     page.write_text(render(
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
         robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
+        home=index_from(multiverse.name, cfg.scale),
         scale_note=scale_note(cfg.scale), config=OmegaConf.to_yaml(cfg.experiment),
         command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
