@@ -32,6 +32,7 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.atomic import DiskFull
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
@@ -149,7 +150,7 @@ def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
     from replication.runner.execute import BackendError, execute
     from replication.runner.failures import exit_if_failed
-    from replication.runner.store import Store, StoreFull
+    from replication.runner.store import Store
     from replication.runner.validate import prepare
     from replication.runner.variant import differences, report_name
 
@@ -189,7 +190,7 @@ def run_experiment(cfg: DictConfig) -> None:
         else:
             run_companions(cfg)
         exit_if_failed(store, runs)
-    except (BackendError, StoreFull) as error:
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
@@ -200,7 +201,7 @@ def run_multiverse(cfg: DictConfig) -> None:
     experiments' stores, then write its report and the index."""
     from replication.runner.execute import BackendError, execute
     from replication.runner.multiverse import load
-    from replication.runner.store import Store, StoreFull
+    from replication.runner.store import Store
     from replication.runner.validate import parallel_settings
 
     try:
@@ -241,7 +242,7 @@ def run_multiverse(cfg: DictConfig) -> None:
         written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task), store_of)
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
-    except (BackendError, StoreFull) as error:
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
@@ -341,5 +342,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         module, function = SUBCOMMANDS[command].split(":")
         getattr(importlib.import_module(module), function)(argv)
+    except DiskFull as error:  # a report, the record or an export: the folder named, its files whole
+        fail(str(error))
     except KeyboardInterrupt:
         interrupted()
