@@ -115,8 +115,6 @@ class Store:
         if not isinstance(record, dict):
             raise CorruptRecord(path, f"a JSON {type(record).__name__}, not an object")
         claimed = record.pop(CHECKSUM, None)
-        if claimed is not None and claimed != checksum(record):
-            raise CorruptRecord(path, "its checksum does not match its content: edited or damaged since it was written")
         missing = [key for key in REQUIRED_KEYS if key not in record]
         if missing:
             raise CorruptRecord(path, f"missing {', '.join(missing)}")
@@ -126,9 +124,11 @@ class Store:
         wrong = [key for key, value in expected.items() if record[key] != value]
         if wrong:
             raise CorruptRecord(path, f"{wrong[0]} {_shown(record[wrong[0]])} is not this file's {expected[wrong[0]]!r}")
-        unsound = next(filter(None, (_unsound(key, value) for key, value in record.items())), None)
-        if unsound:
-            raise CorruptRecord(path, unsound)
+        wrong_value = next(filter(None, (unsound(key, value) for key, value in record.items())), None)
+        if wrong_value:
+            raise CorruptRecord(path, wrong_value)
+        if claimed is not None and claimed != checksum(record):  # last: what is wrong is said where it can be
+            raise CorruptRecord(path, "its checksum does not match its content: edited or damaged since it was written")
         if claimed is None:
             self.legacy.add(run.run_id)
         return record
@@ -235,7 +235,7 @@ def checksum(record: dict) -> str:
     return "sha256:" + hashlib.sha256(canonical.encode()).hexdigest()
 
 
-def _unsound(key: str, value) -> str | None:
+def unsound(key: str, value) -> str | None:
     """What is wrong with a record's ``key``: ``value``, if it is a metric whose type or range does not hold
     (:func:`replication.evidence.quantities.quantity` declares each metric's range); None otherwise, and for
     keys that are not metrics."""
