@@ -1,11 +1,11 @@
 """Files written whole or not at all: every file of the store, the reports and the record.
 
-A file is written to a new temporary file in its own folder (``.<name>.<random>.tmp``: hidden, and
-matched by no reader's pattern such as ``*.parquet``), then renamed over its name (``os.replace``, atomic on
-local POSIX file systems and on NFS).  A reader (a browser on a report, another
-command) sees the previous file or the new one, never part of one; a writer that fails, or is killed,
-leaves the previous file as it was (a killed writer leaves its temporary, matched by :data:`TEMPORARIES`).
-A full disk (or quota) while writing is :class:`DiskFull`: one line naming the folder.
+A file is written to a new temporary file in its own folder (``.<name>.<random>.tmp``: hidden, and matched
+by no reader's pattern such as ``*.parquet``), then renamed over its name (``os.replace``, atomic on local
+POSIX file systems and on NFS).  A reader (a browser on a report, another command) sees the previous file
+or the new one, never part of one; a writer that fails, or is killed, leaves the previous file as it was
+(a killed writer leaves its temporary, matched by :data:`TEMPORARIES`).  A full disk (or quota) while
+writing is :class:`DiskFull`: one line naming the folder.
 
     save(path, lambda tmp: frame.to_csv(tmp, index=False))   # any writer that takes a path
     save_figure(fig, path, dpi=110)                          # its format from the name, not the temporary's
@@ -40,9 +40,9 @@ def replacing(path: str | Path) -> Iterator[Path]:
     except BaseException as error:
         tmp.unlink(missing_ok=True)
         if _full(error):
-            raise DiskFull(f"{path.parent}: no space left on its disk (writing {path.name}); every file there is "
-                           "as it was before (each is replaced whole or not at all): free some space and rerun "
-                           "the same command") from None
+            raise DiskFull(f"{path.parent}: no space left on its disk (writing {path.name}); no file there "
+                           "is left part-written (each is replaced whole or not at all): free some space and "
+                           "rerun the same command") from None
         raise
 
 

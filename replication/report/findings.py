@@ -325,7 +325,8 @@ def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str],
             written.append(out / f"{name}.md")
             atomic.write_text(written[-1], text)
     digests = {name: _digest(text) for name, text in pages.items()}
-    atomic.write_text(out / RENDERED, json.dumps({"inputs": rendered_from, "pages": digests}, indent=1) + "\n")
+    rendered = {"inputs": rendered_from, "pages": digests}
+    atomic.write_text(out / RENDERED, json.dumps(rendered, indent=1) + "\n")
     return written
 
 

@@ -74,7 +74,7 @@ REQUIRED_KEYS = (  # written by execute.perform for every task
     "experiment", "method", "condition", "data_condition", "repetition", "run_key", "run_id",
     "base_seed", "replication_version", "wall_s",
 )
-CHECKSUM = "checksum"  # a record's own key: "sha256:" and the SHA-256 of the rest of the record (:func:`checksum`)
+CHECKSUM = "checksum"  # a record's own key: "sha256:" and the SHA-256 of the rest of it (:func:`checksum`)
 CORRUPT_SUFFIX = ".corrupt"
 STALE_TEMPORARY_S = 3600  # a temporary file this old belongs to a writer that was killed
 
@@ -123,12 +123,13 @@ class Store:
                     "base_seed": run.base_seed}
         wrong = [key for key, value in expected.items() if record[key] != value]
         if wrong:
-            raise CorruptRecord(path, f"{wrong[0]} {_shown(record[wrong[0]])} is not this file's {expected[wrong[0]]!r}")
+            found, wanted = _shown(record[wrong[0]]), expected[wrong[0]]
+            raise CorruptRecord(path, f"{wrong[0]} {found} is not this file's {wanted!r}")
         wrong_value = next(filter(None, (unsound(key, value) for key, value in record.items())), None)
         if wrong_value:
             raise CorruptRecord(path, wrong_value)
         if claimed is not None and claimed != checksum(record):  # last: what is wrong is said where it can be
-            raise CorruptRecord(path, "its checksum does not match its content: edited or damaged since it was written")
+            raise CorruptRecord(path, "its checksum does not match its content: edited or damaged since written")
         if claimed is None:
             self.legacy.add(run.run_id)
         return record
@@ -167,8 +168,9 @@ class Store:
 
     def write(self, run: Run, record: dict) -> None:
         """Write ``record`` with its checksum, so that a crash leaves either the whole file or none of it."""
-        record = json.loads(json.dumps(record))  # as a reader gets it back (lists, string keys): what is checked
-        self._write(self.path(run), json.dumps({**record, CHECKSUM: checksum(record)}, indent=1, sort_keys=True))
+        record = json.loads(json.dumps(record))  # as a reader gets it back (lists, string keys): what it checks
+        text = json.dumps({**record, CHECKSUM: checksum(record)}, indent=1, sort_keys=True)
+        self._write(self.path(run), text)
 
     def write_failure(self, run: Run, reason: str) -> None:
         """Record that ``run`` failed, and why (see :mod:`replication.runner.failures`)."""
@@ -188,8 +190,8 @@ class Store:
         try:
             write_text(path, text, durable=True)
         except DiskFull:
-            raise StoreFull(f"{self.directory}: no space left on its disk; every run stored before this one is "
-                            "kept: free some space and rerun the same command to resume") from None
+            raise StoreFull(f"{self.directory}: no space left on its disk; every run stored before this one "
+                            "is kept: free some space and rerun the same command to resume") from None
 
     def load(self, runs: list[Run]) -> pd.DataFrame:
         """The sound records of ``runs`` that are stored, one row per run, each with its run's condition
@@ -223,8 +225,8 @@ class Store:
         """One line, once, on the legacy records read so far (none: nothing)."""
         if self.legacy and not self._said_legacy:
             self._said_legacy = True
-            print(f"{len(self.legacy)} stored record(s) in {self.directory} were written before records carried a "
-                  "checksum: read as legacy, their types and ranges checked", file=sys.stderr)
+            print(f"{len(self.legacy)} stored record(s) in {self.directory} were written before records "
+                  "carried a checksum: read as legacy, their types and ranges checked", file=sys.stderr)
 
 
 def checksum(record: dict) -> str:

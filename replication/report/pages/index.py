@@ -67,9 +67,11 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     record = recorded(reports, papers)
     cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
-    atomic.save(reports / "summary.csv", lambda tmp: cells.drop(columns=["link_text"]).to_csv(tmp, index=False))
+    shown = cells.drop(columns=["link_text"])
+    atomic.save(reports / "summary.csv", lambda tmp: shown.to_csv(tmp, index=False))
     tallies = cell_tallies(cells)
-    atomic.save(reports / "claims.csv", lambda tmp: claims_frame(rows, cells, tallies).to_csv(tmp, index=False))
+    claims = claims_frame(rows, cells, tallies)
+    atomic.save(reports / "claims.csv", lambda tmp: claims.to_csv(tmp, index=False))
     glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
     page = reports / "index.html"
     atomic.write_text(

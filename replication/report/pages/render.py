@@ -50,8 +50,9 @@ def open_in_browser(page: Path, screenshot: Path | None = None, size=(1280, 2000
     url = Path(page).resolve().as_uri()
     with tempfile.TemporaryDirectory(prefix="chromium-") as profile:  # a fresh profile, nothing left in ~
         shot = Path(profile) / "screenshot.png"  # taken here, then put in place whole (replication.atomic)
-        done = subprocess.run([*command, *([f"--screenshot={shot}"] if screenshot is not None else []),
-                               f"--user-data-dir={profile}", url], capture_output=True, text=True, timeout=timeout)
+        taking = [f"--screenshot={shot}"] if screenshot is not None else []
+        done = subprocess.run([*command, *taking, f"--user-data-dir={profile}", url], capture_output=True,
+                              text=True, timeout=timeout)
         if screenshot is not None and done.returncode == 0 and shot.exists():
             atomic.save(screenshot, lambda tmp: shutil.copyfile(shot, tmp))
     console = [line.split("] ", 1)[-1] for line in done.stderr.splitlines() if ":CONSOLE" in line]

@@ -40,8 +40,8 @@ def write_sequence_pages(records: pd.DataFrame, experiment: dict, out: Path) -> 
                              "link": f"{scene}/{figure['link']}" if "link" in figure else None})
         what = experiment["scenes"][scene].get("name", scene)
         page = out / "sequences" / f"{scene}.html"
-        atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: {what}", up="../index.html",
-                               up_label=experiment["name"], meta=f"{len(runs)} runs on {what} (scene {scene})",
-                               sections=sections))
+        atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: {what}",
+                                       up="../index.html", up_label=experiment["name"],
+                                       meta=f"{len(runs)} runs on {what} (scene {scene})", sections=sections))
         links.append({"scene": scene, "link": f"sequences/{scene}.html", "what": what})
     return links

@@ -94,6 +94,6 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
     meta = f"Drawn from the store by: {command}. " + (
         "Missing: " + "; ".join(missing) + ". Run the multirun to store them." if missing else "Every run is stored."
     )
-    atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: sweep of {key}", up="../index.html",
-                           up_label=experiment["name"], meta=meta, sections=sections))
+    atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: sweep of {key}",
+                                   up="../index.html", up_label=experiment["name"], meta=meta, sections=sections))
     return page
