@@ -32,6 +32,7 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.atomic import DiskFull
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
@@ -150,7 +151,7 @@ def run_experiment(cfg: DictConfig) -> None:
     from replication.record.layer import beneath, missing, said
     from replication.runner.execute import BackendError, execute
     from replication.runner.failures import exit_if_failed
-    from replication.runner.store import Store, StoreFull
+    from replication.runner.store import Store
     from replication.runner.validate import prepare
     from replication.runner.variant import differences, report_name
 
@@ -202,7 +203,7 @@ def run_experiment(cfg: DictConfig) -> None:
         else:
             run_companions(cfg)
         exit_if_failed(held, runs)
-    except (BackendError, StoreFull) as error:
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
@@ -231,7 +232,6 @@ def run_multiverse(cfg: DictConfig) -> None:
     from replication.record.layer import missing, reader, said, universes_beneath
     from replication.runner.execute import BackendError, execute
     from replication.runner.multiverse import load
-    from replication.runner.store import StoreFull
     from replication.runner.validate import parallel_settings
 
     try:
@@ -283,7 +283,7 @@ def run_multiverse(cfg: DictConfig) -> None:
                                           reader(recorded, layers))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
-    except (BackendError, StoreFull) as error:
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
@@ -385,5 +385,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         module, function = SUBCOMMANDS[command].split(":")
         getattr(importlib.import_module(module), function)(argv)
+    except DiskFull as error:  # a report, the record or an export: the folder named, its files whole
+        fail(str(error))
     except KeyboardInterrupt:
         interrupted()

@@ -38,6 +38,7 @@ import pandas as pd
 from hydra.errors import HydraException
 from omegaconf.errors import OmegaConfBaseException
 
+from replication import atomic
 from replication.errors import ConfigError, fail
 from replication.paths import experiment_names, resolve
 from replication.run import Run
@@ -101,8 +102,7 @@ def export_results(experiment: str, scale: str, out_dir: str | Path, layout: str
 
 
 def _save(path: Path, values: np.ndarray, fmt: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, values, fmt=fmt, delimiter=",")
+    atomic.save(path, lambda tmp: np.savetxt(tmp, values, fmt=fmt, delimiter=","))
 
 
 def main(argv: list[str]) -> None:

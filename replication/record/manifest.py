@@ -15,6 +15,7 @@ import json
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
+from replication import atomic
 from replication.runner.machine import Machine
 
 MANIFEST = "manifest.json"
@@ -124,9 +125,8 @@ class Manifest:
 
     def write(self, record: Path) -> Path:
         path = Path(record) / MANIFEST
-        path.parent.mkdir(parents=True, exist_ok=True)
         data = {"scale": self.scale, "experiments": {k: asdict(v) for k, v in sorted(self.experiments.items())}}
-        path.write_text(json.dumps(data, indent=1) + "\n")
+        atomic.write_text(path, json.dumps(data, indent=1) + "\n")
         return path
 
     def damaged(self, record: Path) -> list[str]:

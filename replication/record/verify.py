@@ -51,6 +51,7 @@ import numpy as np
 import pyarrow.parquet as pq
 from scipy import stats
 
+from replication import atomic
 from replication.condition import PREFIX
 from replication.errors import ConfigError, fail
 from replication.evidence.statistics import Estimate
@@ -419,8 +420,7 @@ def write_recomputed(found: dict[str, dict], out: Path) -> None:
     """Write :func:`recomputed`'s finding for the index and print it: a line per diverged run and the counts.
     A run beyond the spread is a finding the index shows at its top, not a failed command (make replicate
     goes on)."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(found, indent=1) + "\n")
+    atomic.write_text(out, json.dumps(found, indent=1) + "\n")
     lines = [line for entry in found.values() for line in entry["lines"]]
     print(*lines, sep="\n", end="\n" if lines else "")
     compared = sum(entry["compared"] for entry in found.values())

@@ -24,6 +24,7 @@ from pathlib import Path
 from hydra import compose, initialize_config_dir
 from joblib import Parallel, delayed
 
+from replication import atomic
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.settings import configure
@@ -182,7 +183,7 @@ def findings(argv: list[str]) -> None:
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
         main(["source=record", "pdf=false", "screenshot=true", *argv])
         if (drawn.folder / SCREENSHOT).exists():  # the scorecard's picture, where Chromium is installed
-            shutil.copyfile(drawn.folder / SCREENSHOT, out / PICTURE)
+            atomic.save(out / PICTURE, lambda tmp: shutil.copyfile(drawn.folder / SCREENSHOT, tmp))
             print(f"findings: {out / PICTURE}")
     try:
         pages = render_findings(drawn, out / "templates")

@@ -35,6 +35,7 @@ import pandas as pd
 from hydra import compose, initialize_config_dir
 from omegaconf import DictConfig, OmegaConf
 
+from replication import atomic
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, resolve
 from replication.run import Run
@@ -137,9 +138,9 @@ def write(table: pd.DataFrame, path: Path, csv: bool = True) -> None:
     """
     nested = [c for c in table if table[c].dtype == object and table[c].map(_nested).any()]
     table = table.assign(**{c: table[c].map(lambda v: json.dumps(v) if _nested(v) else v) for c in nested})
-    table.to_parquet(path.with_suffix(".parquet"), index=False)
+    atomic.save(path.with_suffix(".parquet"), lambda tmp: table.to_parquet(tmp, index=False))
     if csv:
-        table.to_csv(path.with_suffix(".csv"), index=False)
+        atomic.save(path.with_suffix(".csv"), lambda tmp: table.to_csv(tmp, index=False))
 
 
 def load_runs(experiment: str, scale: str | None = None, *overrides: str) -> pd.DataFrame:

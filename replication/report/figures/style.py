@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import to_rgb
 
+from replication import atomic
 ORANGE, SKY, GREEN, YELLOW = "#E69F00", "#56B4E9", "#009E73", "#F0E442"
 BLUE, VERMILLION, PURPLE, BLACK = "#0072B2", "#D55E00", "#CC79A7", "#000000"
 PALETTE = (ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILLION, PURPLE, BLACK)  # Okabe and Ito (2008)
@@ -186,6 +187,6 @@ class NothingToDraw(ValueError):
 def save(fig, path: Path, dpi: int = 110) -> Path:
     """Lay out, write and close a figure; the image takes in what lies outside the axes (a legend below)."""
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
+    atomic.save_figure(fig, path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
     plt.close(fig)
     return path

@@ -12,6 +12,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
+from replication import atomic
 from replication.evidence.claims import Result, evaluate, load_own_papers
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
@@ -49,9 +50,9 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
                 continue
             built[table_spec["name"]] = table
             csv = f"{table_spec['name']}.csv"
-            table.written().to_csv(out / csv, index=False)
+            atomic.save(out / csv, lambda tmp: table.written().to_csv(tmp, index=False))
             html = html_table(table.shown())
-            (out / f"{table_spec['name']}.html").write_text(html)
+            atomic.write_text(out / f"{table_spec['name']}.html", html)
             tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv,
                            "note": table.note})
         for figure_spec in spec.get("figures", []):
@@ -77,7 +78,8 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
     page = out / "index.html"
-    page.write_text(
+    atomic.write_text(
+        page,
         render(
             "experiment.html.j2",
             title=experiment.get("title", experiment["name"]),

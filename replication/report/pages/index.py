@@ -14,6 +14,7 @@ import datetime
 from pathlib import Path
 
 import replication
+from replication import atomic
 from replication.paths import experiment_names
 from replication.evidence.claims import load_papers
 from replication.evidence.published import load_published, published_path
@@ -77,12 +78,15 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
     record = recorded(reports, papers)
     cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
-    cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
+    shown = cells.drop(columns=["link_text"])
+    atomic.save(reports / "summary.csv", lambda tmp: shown.to_csv(tmp, index=False))
     tallies = cell_tallies(cells)
-    claims_frame(rows, cells, tallies).to_csv(reports / "claims.csv", index=False)
+    claims = claims_frame(rows, cells, tallies)
+    atomic.save(reports / "claims.csv", lambda tmp: claims.to_csv(tmp, index=False))
     glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
     page = reports / "index.html"
-    page.write_text(
+    atomic.write_text(
+        page,
         render(
             "index.html.j2",
             title=TITLE,

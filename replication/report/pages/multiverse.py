@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
+from replication import atomic
 from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import load_published, published_path
@@ -104,7 +105,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
                for outcome, colour in OUTCOME_COLOURS.items()]
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=7, frameon=False)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    fig.savefig(path, dpi=110, bbox_inches="tight")  # universes' names can be long
+    atomic.save_figure(fig, path, dpi=110, bbox_inches="tight")  # universes' names can be long
     plt.close(fig)
 
 
@@ -129,10 +130,10 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
     frame = pd.DataFrame([{"claim_id": r.claim.id, "universe": c.universe, **{k: v for k, v in c.picks},
                            "verdict": c.verdict.outcome.value, "why": c.verdict.why,
                            "number": c.deciding.number if c.deciding else ""} for r in robustness for c in r.cases])
-    frame.to_csv(out / "cases.csv", index=False)
+    atomic.save(out / "cases.csv", lambda tmp: frame.to_csv(tmp, index=False))
     n_runs = sum(len(runs) for runs in multiverse.runs.values())  # per universe: a shared run in each
     page = out / "index.html"
-    page.write_text(render(
+    atomic.write_text(page, render(
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
         robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
         home=index_from(multiverse.name, cfg.scale),
