@@ -160,7 +160,7 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
     with nullcontext() if address else _ray_on_the_loopback():
         try:
             with _sigterm_kept():
-                ray.init(address=address or "local", log_to_driver=False,
+                ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
                          **({} if address else {"include_dashboard": False}))  # the runner never reads it
         except (ConnectionError, RuntimeError, ValueError) as error:
             where = f"ray at parallel.address={address}" if address else "ray on this machine"
