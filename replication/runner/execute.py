@@ -159,7 +159,8 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
             raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
     with nullcontext() if address else _ray_on_the_loopback():
         try:
-            with _sigterm_kept():
+            with _sigterm_kept(), warnings.catch_warnings():
+                warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
                 ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
                          **({} if address else {"include_dashboard": False}))  # the runner never reads it
         except (ConnectionError, RuntimeError, ValueError) as error:
