@@ -62,7 +62,7 @@ def test_as_many_workers_as_the_cores_allow_or_confirmed_or_on_a_cluster_pass(ma
 
 def test_a_particle_count_that_cannot_fit_is_refused_in_one_line_before_anything_heavy(tmp_path):
     result = probe(tmp_path, "experiment=hspf_ungm", "scale=quick", "experiment.methods.PF.n_particles=10000000000")
-    assert_refused(result, tmp_path, "experiment.methods.PF.n_particles = 10,000,000,000 needs at least",
+    assert_refused(result, tmp_path, "experiment.methods.PF.n_particles = 10,000,000,000: at least",
                    "of memory is available")
     assert "imported: []" in result.stdout
 
@@ -77,12 +77,12 @@ def test_the_particle_estimate_is_a_lower_bound_over_the_workers_running_at_once
     check_particles({"methods": {"PF": {"n_particles": fits}}}, n_jobs=1)
     with pytest.raises(ConfigError) as refused:
         check_particles({"methods": {"PF": {"n_particles": fits // 2 + 1}}}, n_jobs=2)  # two workers at once
-    assert str(refused.value) == (f"experiment.methods.PF.n_particles = {fits // 2 + 1:,} needs at least 10.0 GiB "
+    assert str(refused.value) == (f"experiment.methods.PF.n_particles = {fits // 2 + 1:,}: at least 10.0 GiB needed "
                                   f"({PARTICLE_BYTES} bytes a particle at least, in each of 2 worker(s) at once); "
                                   "10.0 GiB of memory is available")
     check_particles({"methods": {"PF": {"n_particles": fits // 2}}}, n_jobs=2)
     check_runs("experiment.runs.quick", 10 * 2**30 // RUN_BYTES)
-    with pytest.raises(ConfigError, match=r"experiment.runs.quick: 10,485,761 runs needs at least 10.0 GiB"):
+    with pytest.raises(ConfigError, match=r"experiment.runs.quick: 10,485,761 runs: at least 10.0 GiB needed"):
         check_runs("experiment.runs.quick", 10 * 2**30 // RUN_BYTES + 1)
 
 
@@ -93,7 +93,7 @@ def test_a_forced_run_count_that_cannot_fit_is_refused_before_any_run_is_built(m
     with pytest.raises(ConfigError) as refused:
         expand(cfg)
     assert str(refused.value).startswith("experiment.runs.quick = 1,000,000,000 per condition x 3 conditions: "
-                                         "3,000,000,000 runs needs at least 2.8 TiB")
+                                         "3,000,000,000 runs: at least 2.8 TiB needed")
     assert built == []  # counted, not listed
 
 

@@ -111,11 +111,11 @@ def check_runs(setting: str, runs: int) -> None:
 
 
 def check_memory(what: str, needed: int, basis: str) -> None:
-    """``needed`` bytes fit in the memory available now, else one line: ``what`` needs about so much
+    """``needed`` bytes fit in the memory available now, else one line: ``what`` needs at least so much
     (``basis``: how that was estimated), against what is available."""
     available = available_memory()
     if available is not None and needed > available:
-        raise ConfigError(f"{what} needs at least {size(needed)} ({basis}); {size(available)} of memory is available")
+        raise ConfigError(f"{what}: at least {size(needed)} needed ({basis}); {size(available)} of memory is available")
 
 
 def size(n: float) -> str:

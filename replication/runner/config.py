@@ -98,14 +98,16 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     name, kind, seed = exp.name, exp.task, int(cfg.base_seed)  # read once: each lookup costs more than a run
     experiment = experiment_at_scale(cfg)
     scenes = experiment.get("scenes", {})
-    conditions = list(planned(experiment))
-    check_runs(f"experiment.runs.{cfg.scale} = {repetitions:,} per condition x {len(conditions):,} conditions",
-               repetitions * len(conditions))
-    listed = tqdm(total=repetitions * len(conditions), desc=f"{name}: listing its runs", unit="run",
-                  disable=not cfg.get("progress") or repetitions * len(conditions) < MANY_RUNS, mininterval=1.0)
+    # counted in a pass of their own: the runs' blocks are built as they are listed, after the conditions
+    # before them (a check may fill in a block some share), exactly as their keys were always computed
+    conditions = sum(1 for _ in planned(experiment))
+    check_runs(f"experiment.runs.{cfg.scale} = {repetitions:,} per condition x {conditions:,} conditions",
+               repetitions * conditions)
+    listed = tqdm(total=repetitions * conditions, desc=f"{name}: listing its runs", unit="run",
+                  disable=not cfg.get("progress") or repetitions * conditions < MANY_RUNS, mininterval=1.0)
     runs, skipped = [], [] if skipped is None else skipped
     codes: dict[str, str] = {}  # filter name -> the digest of the code its runs execute
-    for method, condition, data_condition, run_model, run_params in conditions:
+    for method, condition, data_condition, run_model, run_params in planned(experiment):
         builder(run_params["filter"])
         if "scene" in run_model:
             if run_model["scene"] not in scenes:
