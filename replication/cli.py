@@ -37,7 +37,8 @@ from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
 from replication.runner.lifeline import (
-    child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
+    child_environment, exit_uncollected, interrupt_status, stop_children, stop_on_sigterm,
+    watch_parent_from_environment,
 )
 from replication.runner.preflight import check_yaml, preflight
 
@@ -137,6 +138,7 @@ def check_request(argv: list[str]) -> None:
 def interrupted(store=None, runs=None) -> None:
     """The one line of a Ctrl-C or SIGTERM, and exit status 128 + the signal (130, 143) as shells expect."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while we count must not print a traceback
+    stop_children()
     if store is None or runs is None:
         print("interrupted: rerun the same command to resume", file=sys.stderr)
     else:
@@ -205,6 +207,9 @@ def run_experiment(cfg: DictConfig) -> None:
         exit_if_failed(held, runs)
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
+    except MemoryError as error:  # beyond the lower bound the checks hold to (replication.runner.bounds)
+        fail(f"{cfg.experiment.name}: a run ran out of memory ({error}): ask for fewer particles or fewer workers "
+             "(n_jobs)")
     except KeyboardInterrupt:
         interrupted(store, runs)
 
@@ -389,3 +394,5 @@ def main(argv: list[str] | None = None) -> None:
         fail(str(error))
     except KeyboardInterrupt:
         interrupted()
+    finally:
+        exit_uncollected()
