@@ -318,14 +318,21 @@ def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsy
         (tmp_path / name).mkdir()
         c.to_csv(tmp_path / name / "claims.csv", index=False)
         s.to_csv(tmp_path / name / "summary.csv", index=False)
-    diff([str(tmp_path / "a"), str(tmp_path / "b")])
+    with pytest.raises(SystemExit) as status:
+        diff([str(tmp_path / "a"), str(tmp_path / "b")])
+    assert status.value.code == 1  # as diff(1): something differs
     out = capsys.readouterr().out
+    assert f"A: {tmp_path / 'a'}: a drawn report, read as it is" in out
     assert "p.b: verdict 'inconclusive' -> 'does not hold'" in out and "p.a:" not in out
     assert "p 1 e PF rmse N=100: ours '4.1 [3.9, 4.3]' -> '4.2 [4.0, 4.4]'" in out
     assert "p.c: robustness 'one reading' -> 'no reading moves the verdict '" in out
     assert "3 claims: 1 changed verdict, 2 changed at all; 1 cells: 1 changed" in out  # p.c's verdict held
-    with pytest.raises(SystemExit):
+    diff([str(tmp_path / "a"), str(tmp_path / "a")])  # the same: nothing differs, exit status 0
+    assert "3 claims: 0 changed verdict, 0 changed at all; 1 cells: 0 changed" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as status:
         diff([str(tmp_path / "a"), str(tmp_path / "nothing")])
+    err = capsys.readouterr().err
+    assert status.value.code == 2 and "nothing: no such folder" in err and "an installed copy ships none" in err
 
 
 def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_record_as_from_the_store(tmp_path):
