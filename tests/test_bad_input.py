@@ -236,7 +236,8 @@ def intact(girl):
     pass
 
 
-DAMAGED = ("experiment=ism_pf_otb", "scale=quick", "+experiment.scenes.Girl.root={here}/otb", "experiment.scenes.Girl.last=20")
+DAMAGED = ("experiment=ism_pf_otb", "scale=quick", "+experiment.scenes.Girl.root={here}/otb",
+           "experiment.scenes.Girl.last=20")
 OWN = ("experiment=hspf", "scale=quick", "data.otb={here}/otb")
 DATA_ERRORS = [  # each on its own copy of Girl's first 20 frames, in {here}/otb, damaged so
     (break_frame, Bad(DAMAGED, "0005.jpg: not a readable image")),
@@ -272,6 +273,25 @@ def test_bad_sequences_fail_in_one_line_before_any_worker(data_errors, number):
     assert not found[number]["workers"] and not {"dask", "distributed", "ray"} & set(found[number]["modules"])
 
 
+def test_frames_and_boxes_that_do_not_pair_up_name_the_frames():
+    """The gaps in the numbering; past its end where it starts at 1; either end where it starts later (OTB's
+    David starts at 0300.jpg); the frames beyond the last box; the first few of many, and how many."""
+    from replication.runner.validate import unpaired
+
+    def frames(numbers):
+        return [Path(f"img/{n:04d}.jpg") for n in numbers]
+
+    here = Path("/data/MyClip")
+    said = unpaired(here, frames(range(1, 500)), 500)
+    assert said == f"{here}: 499 frames but 500 ground-truth boxes: missing img/0500.jpg"
+    assert unpaired(here, frames(n for n in range(1, 501) if n != 250), 500).endswith(": missing img/0250.jpg")
+    assert unpaired(here, frames(n for n in range(1, 501) if n % 7), 500).endswith(
+        ": missing img/0007.jpg, img/0014.jpg, img/0021.jpg ... (71 in all)")
+    assert unpaired(here, frames(range(300, 770)), 471).endswith(
+        ": missing 1 before img/0300.jpg or after img/0769.jpg")
+    assert unpaired(here, frames(range(1, 503)), 500).endswith(": img/0501.jpg, img/0502.jpg beyond the last box")
+
+
 def test_the_intact_copy_passes(tmp_path):
     """The damage above, not the copying, is what the checks catch."""
     from replication.scenes.otb import OTBSequence
@@ -303,15 +323,23 @@ def test_a_users_own_sequences_get_their_own_report_and_leave_the_scorecard_alon
     assert 'href="hspf@mine/index.html"' in (tmp_path / "reports" / "index.html").read_text()
 
 
-@pytest.mark.parametrize("scale", ["quick", "paper"])
-def test_every_shipped_experiment_passes_the_preflight(make_cfg, scale):
-    """The checks refuse nothing the project ships (their rules are about values, not about our configs)."""
+def test_every_shipped_experiment_passes_the_preflight(tmp_path):
+    """The checks refuse nothing the project ships at either scale (their rules are about values, not about our
+    configs).  Each experiment is composed once: no value of the configs depends on the scale until it is
+    applied, which the checks do."""
+    from hydra import compose, initialize_config_dir
+
     from replication.paths import experiment_names
     from replication.runner.preflight import check_yaml, preflight
 
-    for name in experiment_names():
-        written = check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
-        preflight(make_cfg(name, f"scale={scale}", "outside_project=true"), written)
+    out = [f"store={tmp_path / 'experiments'}", f"reports={tmp_path / 'reports'}", "outside_project=true"]
+    with initialize_config_dir(config_dir=str(summary.CONF_DIR), version_base="1.3"):
+        for name in experiment_names():
+            written = check_yaml(summary.CONF_DIR / "experiment" / f"{name}.yaml")
+            cfg = compose("config", overrides=[f"experiment={name}", *out])
+            for scale in ("quick", "paper"):
+                cfg.scale = scale
+                preflight(cfg, written)
 
 
 @pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
@@ -324,8 +352,8 @@ def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_a
         pytest.skip("MOT data not beside the project")
     before = (write_index(tmp_path / "reports").parent / "claims.csv").read_bytes()
     result = cli("experiment=bis_pf_pets", "scale=quick", "experiment.runs.quick=1",
-                 "experiment.scenes.exp6_pets09.name=TUD-Campus", "experiment.scenes.exp6_pets09.last=20", "label=campus",
-                 timeout=900)
+                 "experiment.scenes.exp6_pets09.name=TUD-Campus", "experiment.scenes.exp6_pets09.last=20",
+                 "label=campus", timeout=900)
     assert result.returncode == 0, result.stderr
     assert "reported as bis_pf_pets@campus" in result.stdout
     assert (tmp_path / "reports" / "claims.csv").read_bytes() == before

@@ -14,6 +14,7 @@ store, ``reports/index.html`` links them under the summary of every published
 cell, and ``reports/replication.pdf`` gathers the same tables and figures
 (``pdf=false`` skips it).  ``screenshot=true`` also saves headless Chromium's
 view of the index as ``reports/screenshot.png`` (where Chromium is installed).
+A bar counts the experiments drawn (``progress=false`` hides it).
 """
 
 import shutil
