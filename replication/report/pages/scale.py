@@ -24,7 +24,8 @@ def scale_changes(paper: dict, scaled: dict, path: str = "") -> list[str]:
                 for change in scale_changes(paper[key], scaled[key], f"{path}.{key}")]
     if isinstance(paper, list) and isinstance(scaled, list) and len(paper) == len(scaled) \
             and any(isinstance(value, dict) for value in paper):
-        return [change for i, (a, b) in enumerate(zip(paper, scaled)) for change in scale_changes(a, b, f"{path}[{i}]")]
+        return [change for i, (a, b) in enumerate(zip(paper, scaled))
+                for change in scale_changes(a, b, f"{path}[{i}]")]
     if paper == scaled:
         return []
     shown = ["all" if v is None else str(v) for v in (paper, scaled)]
