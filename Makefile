@@ -12,8 +12,9 @@
 #                  profile its three costliest experiments into it (record/profile.json), and render each
 #                  paper's findings from it (docs/findings/, from docs/findings/templates/)
 # make findings    render each paper's findings from the record into docs/findings/ (after editing a template)
-# make verify      re-compute N (200) recorded runs here (it says how many and roughly how long), grade each against the
-#                  record (identical, within tolerance, diverged) and judge the verdicts again; N=all for every one
+# make verify      re-compute N (200) recorded runs here (it says first how many, then roughly how long), grade each
+#                  against the record (identical, within tolerance, diverged) and judge the verdicts again; N=20 for
+#                  fewer (each experiment and universe still gives one: about 100), N=all for every one
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3

@@ -11,7 +11,7 @@ claims and cells whose verdict or estimate differ between two records or reports
 (:mod:`replication.report.diff`); ``findings`` renders each paper's findings from the record into
 ``docs/findings/`` (:mod:`replication.report.findings`).
 
-Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
+Errors a user can fix (an unknown command, experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
 stderr and exit status 2 before anything heavy is imported or written; never a Hydra traceback.
 Ctrl-C (SIGINT) and SIGTERM stop the workers, keep every run already stored and exit with one line
@@ -56,6 +56,8 @@ SUBCOMMANDS = {
     "diff": "replication.report.diff:main",
     "findings": "replication.report.__main__:findings",
 }
+
+COMMAND_LIKE = re.compile(r"[A-Za-z][\w-]*")  # a first word that is no key=value, +key, ~key or flag
 
 
 def config_dirs(argv: list[str]) -> list[Path]:
@@ -168,7 +170,8 @@ def run_experiment(cfg: DictConfig) -> None:
     if reported_as != cfg.experiment.name:
         what = ("this request changes the shipped experiment (your data or settings)"
                 if cfg.experiment.name in experiment_names() else "your own experiment")
-        print(f"{cfg.experiment.name}: {what}: reported as {reported_as}, judging no paper claim"
+        named = "" if cfg.get("label") else " (a digest of what it changes; label=<name> names it)"
+        print(f"{cfg.experiment.name}: {what}: reported as {reported_as}{named}, judging no paper claim"
               + (f" (your own claims in {cfg.claims_dir})" if cfg.get("claims_dir") else ""))
     for message in skipped:
         print(f"skipped: {message}", file=sys.stderr)
@@ -386,6 +389,8 @@ def main(argv: list[str] | None = None) -> None:
     os.environ[HOME_VARIABLE] = str(project_dir())  # workers and companions resolve paths as we do
     stop_on_sigterm()
     watch_parent_from_environment()  # a companion experiment ends with the runner that started it
+    if argv and argv[0] not in SUBCOMMANDS and COMMAND_LIKE.fullmatch(argv[0]):  # a word: no setting, no flag
+        fail(f"unknown command {argv[0]!r}; commands: {', '.join(SUBCOMMANDS)} (pf-replicate --help)")
     command, argv = (argv[0], argv[1:]) if argv and argv[0] in SUBCOMMANDS else ("run", argv)
     try:
         module, function = SUBCOMMANDS[command].split(":")

@@ -170,12 +170,14 @@ def test_an_unreachable_ray_address_is_one_line_at_once(make_cfg, tmp_path):
     pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
     from replication.runner.execute import BackendError
 
+    import ray
+
     runs = expand(make_cfg("hspf_ungm", *TINY))
-    started = time.monotonic()
     with pytest.raises(BackendError) as error:
         execute(runs, Store(tmp_path, "hspf_ungm"), backend="ray", address="127.0.0.1:9", progress=False)
     assert str(error.value).startswith("cannot reach ray at parallel.address=127.0.0.1:9: ")
-    assert "\n" not in str(error.value) and time.monotonic() - started < 15
+    assert "\n" not in str(error.value)
+    assert not ray.is_initialized()  # what makes it quick: ray.init, which retries for minutes, was never called
     assert not (tmp_path / "hspf_ungm").exists()
 
 

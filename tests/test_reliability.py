@@ -341,14 +341,12 @@ OTB_SCENE = ("experiment=ism_pf_otb", "experiment.model.sweep.scene=[Girl]")
     ],
 )
 def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args, message):
-    started = time.perf_counter()
-    result = cli(*args, "scale=quick", timeout=60)
-    elapsed = time.perf_counter() - started
+    """(What makes them quick, no heavy import before a config error, is tests/test_bad_input.py's.)"""
+    result = cli(*args, "scale=quick", timeout=300)
     assert result.returncode == 2, result.stderr
     assert message in result.stderr
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert not (tmp_path / "experiments").exists()  # no work started
-    assert elapsed < 20, elapsed  # interpreter start and imports on a loaded 2-core machine; the check is below
 
 
 @pytest.mark.parametrize(
@@ -367,12 +365,19 @@ def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args
         ("hspf_ungm", ("n_jobs=0",), "n_jobs"),
     ],
 )
-def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key):
+def test_config_checks_fail_before_any_scene_is_built(make_cfg, monkeypatch, experiment, overrides, key):
+    """What would make a check slow is building a scene (reading a sequence's frames, drawing a synthetic one):
+    every check fails before the first is built."""
+    from replication.scenes import factory
+
+    def built(spec):
+        raise AssertionError(f"a scene was built before the check: {spec.get('name')}")
+
+    monkeypatch.setattr(factory, "build_sequence", built)
+    factory._cached.cache_clear()
     cfg = make_cfg(experiment, "scale=quick", *overrides)
-    started = time.perf_counter()
     with pytest.raises(ConfigError) as error:
         prepare(cfg)
-    assert time.perf_counter() - started < 1.0
     assert key in str(error.value) and "\n" not in str(error.value)
 
 
@@ -385,10 +390,9 @@ def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key)
     ],
 )
 def test_hydra_override_errors_are_one_line(argv, message):
-    started = time.perf_counter()
+    """(That they come before any heavy import is tests/test_bad_input.py's, in a fresh interpreter.)"""
     with pytest.raises(ConfigError) as error:
         check_request(argv)
-    assert time.perf_counter() - started < 1.0
     assert message in str(error.value) and "\n" not in str(error.value)
 
 

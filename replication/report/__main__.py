@@ -15,6 +15,7 @@ store, ``reports/index.html`` links them under the summary of every published
 cell, and ``reports/replication.pdf`` gathers the same tables and figures
 (``pdf=false`` skips it).  ``screenshot=true`` also saves headless Chromium's
 view of the index as ``reports/screenshot.png`` (where Chromium is installed).
+A bar counts the experiments drawn (``progress=false`` hides it).
 """
 
 import shutil
@@ -23,6 +24,7 @@ from pathlib import Path
 
 from hydra import compose, initialize_config_dir
 from joblib import Parallel, delayed
+from tqdm.auto import tqdm
 
 from replication import atomic
 from replication.errors import ConfigError, fail
@@ -85,7 +87,10 @@ def main(argv: list[str]) -> None:
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # the settings: workers, folders
         cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
     try:  # each experiment's pages on its own worker (the order of the output is the experiments')
-        drawn = Parallel(n_jobs=cfg.n_jobs)(delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+        pages = Parallel(n_jobs=cfg.n_jobs, return_as="generator")(
+            delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+        drawn = list(tqdm(pages, total=len(names), desc="pages", unit="experiment", disable=not cfg.progress,
+                          mininterval=1.0))
     except ConfigError as error:
         fail(str(error))
     stale = {}  # drawn from the record: per experiment, its recorded runs that other code made
@@ -178,8 +183,7 @@ def findings(argv: list[str]) -> None:
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
     drawn = Drawn(resolve(settings["reports"]) / PAGES)
     rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
-    drawn_from = drawn.status.get("drawn_from") if (drawn.folder / STATUS).exists() else None
-    if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
+    if drawn_pages(record, argv) is None:  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
         main(["source=record", "pdf=false", "screenshot=true", *argv])
         if (drawn.folder / SCREENSHOT).exists():  # the scorecard's picture, where Chromium is installed
@@ -192,6 +196,17 @@ def findings(argv: list[str]) -> None:
         fail(str(error))
     for page in written:
         print(f"findings: {page}")
+
+
+def drawn_pages(record: Path, overrides: list[str]) -> Path | None:
+    """``<reports>/record`` where it holds ``record``'s pages drawn by this code from these configs and published
+    values (``report source=record`` wrote them); None where it does not."""
+    settings = _settings(overrides)
+    folder = resolve(settings["reports"]) / PAGES
+    rendered_from = inputs(record, resolve(settings["findings"]) / "templates",
+                           published_path(settings["published_values"]))
+    drawn_from = Drawn(folder).status.get("drawn_from") if (folder / STATUS).exists() else None
+    return folder if drawn_from == drawn_inputs(rendered_from) else None
 
 
 def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -> tuple[list[str], list[str]]:

@@ -8,8 +8,8 @@ decodable) is :mod:`replication.runner.validate`'s, after the imports but still 
 Numbers are checked by what their key names: every number is finite; a ``sigma`` or a variance is
 positive, a standard deviation (``*_sd``, ``P0``) is not negative; counts (``n_*``, ``steps``, ...)
 are positive integers; and a key that names one of these holds a number, not a word (``Q=abc``).
-Names that become file names (the experiment's, its methods' and scenes') are restricted to
-:data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
+Names that become file names (the experiment's, its methods' and scenes', the sequences of
+``sequences=``) are restricted to :data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
 directory unless ``outside_project=true``.  What a request asks of this machine (local workers, particles
 in memory) is bounded by :mod:`replication.runner.bounds`.
 """
@@ -70,6 +70,7 @@ def check_settings(cfg: DictConfig) -> None:
     record = cfg.get("record")
     if not isinstance(record, str) or not record:
         raise ConfigError(f"record must be a folder (a clone's record/), got {record!r}")
+    check_sequences(cfg.get("sequences"))
     claims = cfg.get("claims_dir")
     if claims is not None and (not isinstance(claims, str) or not resolve(claims).is_dir()):
         raise ConfigError(f"claims_dir must be a folder of your claims files (*.yaml), got {claims!r}")
@@ -83,6 +84,15 @@ def check_settings(cfg: DictConfig) -> None:
                 f"add outside_project=true to write there"
             )
         check_writable(key, resolve(value))
+
+
+def check_sequences(sequences: Any) -> None:
+    """Each name of ``sequences=[...]`` is a sequence's folder name in ``data.otb`` / ``data.mot``, never a path
+    (``../otb/Girl``, ``/data/Girl``): where sequences are read from is ``data.*``'s to say."""
+    for name in sequences if isinstance(sequences, ListConfig) else ():
+        if isinstance(name, str) and not SAFE_NAME.fullmatch(name):
+            raise ConfigError(f"sequences: {name!r} is a path, not a sequence's name (no / or \\, no leading dot); "
+                              "say where sequences are with data.otb= (data.mot=) and name them by folder")
 
 
 def check_writable(key: str, folder: Path) -> None:

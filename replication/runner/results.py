@@ -63,6 +63,7 @@ class Results:
     changes: tuple[str, ...] = ()  # what the request changed in the shipped experiment (runner.variant)
     command: str = ""  # the command line that made these results
     curves: dict[str, pd.DataFrame] = field(default_factory=dict)  # figure -> its curve table, where kept (record)
+    at_paper_scale: dict = field(default_factory=dict)  # ``experiment`` at the paper's scale: what a scale changes
 
     @classmethod
     def of(cls, cfg: DictConfig, runs: list[Run], store: Store, overrides: tuple[str, ...] = (),
@@ -72,8 +73,10 @@ class Results:
         changes = differences(cfg)
         command = " ".join(["python -m replication", f"experiment={cfg.experiment.name}", f"scale={cfg.scale}",
                             *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])
-        return cls(experiment_at_scale(cfg), runs, store.load(runs), store.failures(runs),
-                   report_name(cfg, changes), tuple(changes), command, curves or {})
+        experiment = experiment_at_scale(cfg)
+        return cls(experiment, runs, store.load(runs), store.failures(runs), report_name(cfg, changes),
+                   tuple(changes), command, curves or {}, experiment_at_scale(cfg, "paper") if cfg.scale != "paper"
+                   else experiment)
 
     @property
     def own(self) -> bool:

@@ -73,7 +73,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     # methods), only the user's own claims (claims_dir), by the same rules
     own = load_own_papers(resolve(cfg.claims_dir)) if results.own and cfg.get("claims_dir") else ()
     claims = evaluate(experiment["name"], experiment, records, built, published, own if results.own else None)
-    changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
+    changes = scale_changes(results.at_paper_scale, experiment)
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
