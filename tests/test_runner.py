@@ -20,7 +20,7 @@ from replication.errors import ConfigError
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.provenance import code_digest
-from replication.runner.store import CHECKSUM, Store
+from replication.runner.store import CHECKSUM, Store, checksum
 from replication.seeding import seed_sequence
 
 
@@ -99,7 +99,7 @@ def test_expansion_is_method_by_condition_by_repetition(make_cfg):
         ("PF", 500), ("PF", 200), ("PF", 100), ("grid", None)
     }
     assert len({r.run_id for r in runs}) == len(runs)
-    paper = expand(make_cfg("gps_qmcpf"))
+    paper = expand(make_cfg("gps_qmcpf", "scale=paper"))  # quick is the default
     assert len(paper) == 16 * 100
 
 
@@ -228,9 +228,9 @@ def test_store_write_is_atomic(tmp_path, make_cfg):
     with pytest.raises(TypeError):
         store.write(run, {"x": Unserialisable()})
     assert not store.has(run)
-    assert list(store.directory.iterdir()) == []  # no partial file, no stray temporary
+    assert [p for p in tmp_path.rglob("*") if p.is_file()] == []  # no partial file, no stray temporary
     store.write(run, {"x": 1.0})
-    assert json.loads(store.path(run).read_text()) == {"x": 1.0}
+    assert json.loads(store.path(run).read_text()) == {"x": 1.0, CHECKSUM: checksum({"x": 1.0})}
 
 
 @pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o002, 0o664), (0o077, 0o600)])

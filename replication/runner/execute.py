@@ -368,6 +368,8 @@ def execute(
     A KeyboardInterrupt stops the workers and propagates, with every record
     that arrived before it stored.
     """
+    if not runs:  # every run read from the record, say
+        return 0
     checked = tqdm(runs, desc=f"{runs[0].experiment}: checking the store", unit="run", mininterval=1.0,
                    disable=not progress or len(runs) < MANY_RUNS)
     pending, corrupt = store.pending(checked)
