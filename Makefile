@@ -12,8 +12,9 @@
 #                  profile its three costliest experiments into it (record/profile.json), and render each
 #                  paper's findings from it (docs/findings/, from docs/findings/templates/)
 # make findings    render each paper's findings from the record into docs/findings/ (after editing a template)
-# make verify      re-compute N (200) recorded runs here (it says how many and roughly how long), grade each against the
-#                  record (identical, within tolerance, diverged) and judge the verdicts again; N=all for every one
+# make verify      re-compute N (200) recorded runs here (it says first how many, then roughly how long), grade each
+#                  against the record (identical, within tolerance, diverged) and judge the verdicts again; N=20 for
+#                  fewer (each experiment and universe still gives one: about 100), N=all for every one
 # SCALE=paper      the papers' run counts, e.g. make replicate SCALE=paper JOBS=2
 
 PYTHON ?= python3
@@ -64,8 +65,9 @@ test-all: setup browser
 # One Hydra multirun over every experiment: one process and one pool of workers for all of them,
 # instead of starting Python, numba and the workers again per experiment (about two minutes at quick scale).
 # The shipped record's pages first (the verdicts at the papers' scale, in about a minute), then this
-# machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the
-# record is rewritten from the runs just made (a file whose runs did not change keeps its bytes).
+# machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the runs the
+# record holds as this code computes them are read from it, not computed (skip_recorded=false in conf/config.yaml
+# computes all), and the record is rewritten with the runs just made (a file whose runs did not change keeps its bytes).
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
 	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)

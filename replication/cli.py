@@ -11,7 +11,7 @@ claims and cells whose verdict or estimate differ between two records or reports
 (:mod:`replication.report.diff`); ``findings`` renders each paper's findings from the record into
 ``docs/findings/`` (:mod:`replication.report.findings`).
 
-Errors a user can fix (an unknown experiment or key, a value of the wrong type or out of range, a
+Errors a user can fix (an unknown command, experiment or key, a value of the wrong type or out of range, a
 broken experiment file, an output folder outside the project or not writable) are one line on
 stderr and exit status 2 before anything heavy is imported or written; never a Hydra traceback.
 Ctrl-C (SIGINT) and SIGTERM stop the workers, keep every run already stored and exit with one line
@@ -32,11 +32,13 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.atomic import DiskFull
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
 from replication.runner.lifeline import (
-    child_environment, interrupt_status, stop_on_sigterm, watch_parent_from_environment,
+    child_environment, exit_uncollected, interrupt_status, stop_children, stop_on_sigterm,
+    watch_parent_from_environment,
 )
 from replication.runner.preflight import check_yaml, preflight
 
@@ -54,6 +56,8 @@ SUBCOMMANDS = {
     "diff": "replication.report.diff:main",
     "findings": "replication.report.__main__:findings",
 }
+
+COMMAND_LIKE = re.compile(r"[A-Za-z][\w-]*")  # a first word that is no key=value, +key, ~key or flag
 
 
 def config_dirs(argv: list[str]) -> list[Path]:
@@ -136,6 +140,7 @@ def check_request(argv: list[str]) -> None:
 def interrupted(store=None, runs=None) -> None:
     """The one line of a Ctrl-C or SIGTERM, and exit status 128 + the signal (130, 143) as shells expect."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while we count must not print a traceback
+    stop_children()
     if store is None or runs is None:
         print("interrupted: rerun the same command to resume", file=sys.stderr)
     else:
@@ -147,9 +152,10 @@ def interrupted(store=None, runs=None) -> None:
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
 def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
+    from replication.record.layer import beneath, missing, said
     from replication.runner.execute import BackendError, execute
     from replication.runner.failures import exit_if_failed
-    from replication.runner.store import Store, StoreFull
+    from replication.runner.store import Store
     from replication.runner.validate import prepare
     from replication.runner.variant import differences, report_name
 
@@ -164,22 +170,35 @@ def run_experiment(cfg: DictConfig) -> None:
     if reported_as != cfg.experiment.name:
         what = ("this request changes the shipped experiment (your data or settings)"
                 if cfg.experiment.name in experiment_names() else "your own experiment")
-        print(f"{cfg.experiment.name}: {what}: reported as {reported_as}, judging no paper claim"
+        named = "" if cfg.get("label") else " (a digest of what it changes; label=<name> names it)"
+        print(f"{cfg.experiment.name}: {what}: reported as {reported_as}{named}, judging no paper claim"
               + (f" (your own claims in {cfg.claims_dir})" if cfg.get("claims_dir") else ""))
     for message in skipped:
         print(f"skipped: {message}", file=sys.stderr)
     store = Store(resolve(cfg.store), cfg.experiment.name)
+    held = beneath(cfg, runs, store)  # at paper scale, the record's runs beneath the store
+    if note := missing(cfg):
+        print(note, file=sys.stderr)
+    if cfg.dry_run:
+        plan(cfg, runs, held, n_jobs)
+        if reported_as == cfg.experiment.name:  # as a run does: a changed experiment runs without its companions
+            run_companions(cfg)
+        return
+    if held.recorded:
+        print(said(cfg.experiment.name, [held], len(runs)), flush=True)
     try:
-        done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
-        stored = len(runs) - done
-        print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}")
+        computed = held.computed(runs)
+        done = execute(computed, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
+        stored = len(computed) - done
+        print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
+              + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
         from replication.report.pages.experiment import write_experiment_report
         from replication.report.pages.index import write_index
         from hydra.core.hydra_config import HydraConfig
 
         from replication.runner.results import Results
 
-        results = Results.of(cfg, runs, store, tuple(HydraConfig.get().overrides.task))
+        results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
         written = write_experiment_report(cfg, results)
         index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
         print(f"{cfg.experiment.name}: report in {written}; index in {index}")
@@ -188,19 +207,39 @@ def run_experiment(cfg: DictConfig) -> None:
                   "this request changes it (your data or settings); run one by name if you want it", file=sys.stderr)
         else:
             run_companions(cfg)
-        exit_if_failed(store, runs)
-    except (BackendError, StoreFull) as error:
+        exit_if_failed(held, runs)
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
+    except MemoryError as error:  # beyond the lower bound the checks hold to (replication.runner.bounds)
+        fail(f"{cfg.experiment.name}: a run ran out of memory ({error}): ask for fewer particles or fewer workers "
+             "(n_jobs)")
     except KeyboardInterrupt:
         interrupted(store, runs)
+
+
+def plan(cfg: DictConfig, runs: list, held, n_jobs: int) -> None:
+    """``dry_run=true``: how many runs the request has, how many are stored and how many read from the record
+    (``held``, :class:`~replication.record.layer.Layered`), and roughly how long the rest would take
+    (:func:`~replication.runner.execute.forecast`, from the times of the runs stored or recorded); nothing is
+    run or written."""
+    from replication.runner.execute import forecast
+
+    computed = held.computed(runs)
+    pending = [run for run in computed if not (held.store.path(run).exists() or held.store.failure_path(run).exists())]
+    name = cfg.experiment.name
+    print(f"{name}: {len(runs):,} runs at the {cfg.scale} scale: {len(computed) - len(pending):,} stored, "
+          f"{len(held.recorded):,} read from the record, {len(pending):,} to compute")
+    if pending:
+        print(forecast(runs, pending, held, n_jobs))
+    print(f"{name}: a dry run: nothing computed or written (without dry_run=true this request runs)", flush=True)
 
 
 def run_multiverse(cfg: DictConfig) -> None:
     """Run every universe of a paper's multiverse (:mod:`replication.runner.multiverse`) into its base
     experiments' stores, then write its report and the index."""
+    from replication.record.layer import missing, reader, said, universes_beneath
     from replication.runner.execute import BackendError, execute
     from replication.runner.multiverse import load
-    from replication.runner.store import Store, StoreFull
     from replication.runner.validate import parallel_settings
 
     try:
@@ -216,8 +255,19 @@ def run_multiverse(cfg: DictConfig) -> None:
     print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices, "
           f"{distinct} distinct runs")
     store, runs = None, None
-    recorded = recorded_universes(cfg, multiverse)
-    print(multiverse_forecast(cfg, multiverse, recorded, n_jobs), flush=True)
+    recorded, layers = universes_beneath(cfg, multiverse)
+    if note := missing(cfg):
+        print(note, file=sys.stderr)
+    if (read := said(name, list(layers.values()), distinct)) and not cfg.dry_run:
+        print(read, flush=True)
+    print(multiverse_forecast(cfg, multiverse, recorded, n_jobs, layers), flush=True)
+    if cfg.dry_run:
+        counted = ", ".join(f"{len(runs):,} {where}" for where, runs in universes_left(cfg, multiverse, recorded,
+                                                                                        layers).items())
+        print(f"{name}: {len(recorded)} of {len(multiverse.universes)} universes read whole from the record; of "
+              f"the others' runs {counted}")
+        print(f"{name}: a dry run: nothing computed or written (without dry_run=true this request runs)")
+        return
     try:
         # universe by universe, the default first: a multiverse stopped part-way (a session's end, a Ctrl-C)
         # leaves whole universes, which the record takes one by one (replication.record.write)
@@ -227,54 +277,38 @@ def run_multiverse(cfg: DictConfig) -> None:
                 print(f"{where}: in the record as this code computes it (skip_recorded=false runs it)", flush=True)
                 continue
             for experiment in multiverse.experiments:
-                store, runs = Store(resolve(cfg.store), experiment), multiverse.runs[universe.name, experiment]
+                held = layers[universe.name, experiment]
+                store, runs = held.store, held.computed(multiverse.runs[universe.name, experiment])
                 done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
-                print(f"{where}: {experiment}: {done} runs computed, {len(runs) - done} already stored", flush=True)
+                print(f"{where}: {experiment}: {done} runs computed, {len(runs) - done} already stored"
+                      + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
         from hydra.core.hydra_config import HydraConfig
 
         from replication.report.pages.index import write_index
         from replication.report.pages.multiverse import write_multiverse_report
 
-        def store_of(experiment, universe):  # a universe skipped as recorded is read from the record
-            return recorded[universe.name] if universe.name in recorded else Store(resolve(cfg.store), experiment)
-
-        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task), store_of)
+        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task),
+                                          reader(recorded, layers))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
-    except (BackendError, StoreFull) as error:
+    except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:
         interrupted(store, runs)
 
 
-def recorded_universes(cfg: DictConfig, multiverse) -> dict:
-    """The universes of ``multiverse`` that the paper-scale record holds as this code computes them, each as
-    the record's view of it (:meth:`~replication.record.runs.Record.universes_held`); none unless
-    ``skip_recorded`` and the paper scale.  A multiverse too long for one sitting then goes on, on any
-    machine, where the record stops."""
-    if not (cfg.get("skip_recorded") and cfg.scale == "paper"):
-        return {}
-    from replication.record.runs import Record
-
-    return Record(resolve(cfg.record)).universes_held(multiverse)
-
-
-def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int) -> str:
+def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int, layers: dict | None = None) -> str:
     """How many of the multiverse's runs are left to compute (neither in the store nor in a universe read from
-    the record) and, at paper scale, roughly how long: each at the mean time the record gives its method and
-    condition in the default universe (the base experiments), over the workers."""
+    the record, nor read from the record beneath the store: ``layers``, a
+    :class:`~replication.record.layer.Layered` per universe and experiment) and, at paper scale, roughly how
+    long: each at the mean time the record gives its method and condition in the default universe (the base
+    experiments), over the workers."""
     from joblib import effective_n_jobs
 
     from replication.record.runs import Record
     from replication.runner.execute import duration
-    from replication.runner.store import Store
 
-    stores, left = {e: Store(resolve(cfg.store), e) for e in multiverse.experiments}, {}
-    for universe in multiverse.universes:
-        for experiment, store in stores.items() if universe.name not in recorded else ():
-            # a file's presence, not its soundness (Store.has reads it): a forecast reads no records
-            left.update((run.run_id, run) for run in multiverse.runs[universe.name, experiment]
-                        if not (store.path(run).exists() or store.failure_path(run).exists()))
+    left = universes_left(cfg, multiverse, recorded, layers)["to compute"]
     said = f"{multiverse.name}: {len(left):,} runs to compute"
     base = [run for experiment in multiverse.experiments for run in multiverse.runs["default", experiment]]
     record = Record(resolve(cfg.record))  # the base experiments' records, else the default universe's
@@ -287,6 +321,24 @@ def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int
     unknown = f"; {len(left) - len(timed):,} with no recorded time not counted" if len(timed) < len(left) else ""
     return (f"{said}, about {duration(sum(timed) / workers)} on {workers} worker(s) (from the record's times of "
             f"the same methods and conditions{unknown})")
+
+
+def universes_left(cfg: DictConfig, multiverse, recorded: dict, layers: dict | None = None) -> dict[str, dict]:
+    """The distinct runs of the universes not read whole from the record (``recorded``), by where they are:
+    ``stored`` (a file's presence, not its soundness: a forecast reads no records), ``read from the record``
+    beneath the store (``layers``, per universe and experiment) and ``to compute``, each by experiment and run
+    id."""
+    from replication.runner.store import Store
+
+    found = {"stored": {}, "read from the record": {}, "to compute": {}}
+    for universe in multiverse.universes:
+        for experiment in multiverse.experiments if universe.name not in recorded else ():
+            store, layer = Store(resolve(cfg.store), experiment), (layers or {}).get((universe.name, experiment))
+            for run in multiverse.runs[universe.name, experiment]:
+                where = ("stored" if store.path(run).exists() or store.failure_path(run).exists() else
+                         "read from the record" if layer and run.run_id in layer.recorded else "to compute")
+                found[where][experiment, run.run_id] = run
+    return found
 
 
 def run_companions(cfg: DictConfig) -> None:
@@ -337,9 +389,15 @@ def main(argv: list[str] | None = None) -> None:
     os.environ[HOME_VARIABLE] = str(project_dir())  # workers and companions resolve paths as we do
     stop_on_sigterm()
     watch_parent_from_environment()  # a companion experiment ends with the runner that started it
+    if argv and argv[0] not in SUBCOMMANDS and COMMAND_LIKE.fullmatch(argv[0]):  # a word: no setting, no flag
+        fail(f"unknown command {argv[0]!r}; commands: {', '.join(SUBCOMMANDS)} (pf-replicate --help)")
     command, argv = (argv[0], argv[1:]) if argv and argv[0] in SUBCOMMANDS else ("run", argv)
     try:
         module, function = SUBCOMMANDS[command].split(":")
         getattr(importlib.import_module(module), function)(argv)
+    except DiskFull as error:  # a report, the record or an export: the folder named, its files whole
+        fail(str(error))
     except KeyboardInterrupt:
         interrupted()
+    finally:
+        exit_uncollected()

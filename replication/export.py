@@ -1,6 +1,6 @@
 """Tracking results in the result layouts of the OTB and GOT-10k toolkits, for other toolkits to re-score.
 
-``export_results("hspf", "quick", "reports/hspf/results", layout="got10k")`` reads the stored runs
+``export_results("hspf", "quick", "reports/quick/hspf/results", layout="got10k")`` reads the stored runs
 of a tracking experiment and writes every run on a real OTB sequence, one box per frame, as the GOT-10k
 toolkit (Huang, Zhao and Huang, TPAMI 2021; ``got10k.experiments``) records a tracker's results:
 
@@ -20,10 +20,11 @@ the method with the conditions other than the scene (``PF_N=10``); ``<sequence>`
 (``Jogging-2``, which the GOT-10k toolkit's OTB reader calls ``Jogging.2``).  A file holds the frames
 the run tracked: the first 100 at the quick scale.  Every exported tracker's folder is written anew.
 
-    python -m replication.export experiment=hspf [scale=paper|quick] [layout=otb|got10k] [out=DIR] [key=value ...]
+    python -m replication.export experiment=hspf [scale=quick|paper] [layout=otb|got10k] [out=DIR] [key=value ...]
 
-writes both layouts unless ``layout`` names one, under ``<reports>/<experiment>/results`` (as the report
-does) unless ``out`` says where; ``key=value`` are config overrides (``store=/path``).
+writes both layouts unless ``layout`` names one, under the report's folder's ``results`` (as the report
+does: ``<reports>/quick/<experiment>/results`` at the quick scale, the default) unless ``out`` says where;
+``key=value`` are config overrides (``store=/path``).
 """
 
 import re
@@ -37,11 +38,13 @@ import pandas as pd
 from hydra.errors import HydraException
 from omegaconf.errors import OmegaConfBaseException
 
+from replication import atomic
 from replication.errors import ConfigError, fail
 from replication.paths import experiment_names, resolve
 from replication.run import Run
 from replication.runner.results import stored_records
 from replication.scenes.factory import OTB, scene_kind
+from replication.scales import default_scale, report_folder
 
 LAYOUTS = {"otb": "OTB2015", "got10k": "GOT-10k"}  # layout: the toolkit's folder under its result_dir
 
@@ -100,8 +103,7 @@ def export_results(experiment: str, scale: str, out_dir: str | Path, layout: str
 
 
 def _save(path: Path, values: np.ndarray, fmt: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, values, fmt=fmt, delimiter=",")
+    atomic.save(path, lambda tmp: np.savetxt(tmp, values, fmt=fmt, delimiter=","))
 
 
 def main(argv: list[str]) -> None:
@@ -112,9 +114,9 @@ def main(argv: list[str]) -> None:
     name = options.pop("experiment", None)
     if name not in experiment_names():
         fail(f"name a tracking experiment: experiment=<name>; known: {', '.join(experiment_names())}")
-    scale = options.pop("scale", "paper")
+    scale = options.pop("scale", None) or default_scale()
     layouts = [options.pop("layout")] if "layout" in options else list(LAYOUTS)
-    out = Path(options.pop("out", resolve(options.get("reports", "reports")) / name / "results"))
+    out = Path(options.pop("out", report_folder(resolve(options.get("reports", "reports")), name, scale) / "results"))
     try:
         for layout in layouts:
             written = export_results(name, scale, out, layout, tuple(f"{k}={v}" for k, v in options.items()))

@@ -1,3 +1,4 @@
+import os
 import signal
 import sys
 from pathlib import Path
@@ -5,7 +6,7 @@ from pathlib import Path
 import pytest
 from hydra import compose, initialize_config_dir
 
-from replication.paths import CONF_DIR
+from replication.paths import CONF_DIR, HOME_VARIABLE
 
 PROJECT_ROOT = Path(__file__).resolve().parents[1]  # the checkout: the commands run from it
 
@@ -16,6 +17,19 @@ def pytest_configure(config):
     the reliability tests send SIGINT to the runner and to its workers."""
     if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+@pytest.fixture(autouse=True)
+def project_home_restored():
+    """The command line sets ``$REPLICATION_HOME`` for its workers; a test that calls it in-process must not
+    leave it to the tests after it in the same worker, whose subprocesses would then resolve their store in
+    this checkout (a copy of the project ran its runs into this clone's ``experiments/``)."""
+    saved = os.environ.get(HOME_VARIABLE)
+    yield
+    if saved is None:
+        os.environ.pop(HOME_VARIABLE, None)
+    else:
+        os.environ[HOME_VARIABLE] = saved
 
 
 @pytest.fixture

@@ -1,18 +1,24 @@
 """Beyond one machine: the dask and ray backends (a local cluster standing in for a real one)
-and the threading backend store the same records as loky."""
+and the threading backend store the same records as loky; a local cluster listens on the loopback alone;
+one SIGTERM stops every local backend and everything it started."""
 
+import ipaddress
 import logging
 import os
 import secrets
 import shutil
+import signal
 import socket
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import PROJECT_ROOT
+from test_reliability import INTERRUPTED, NEEDS_PROC, command, descendants, processes, still_running
 
 from replication.runner.config import expand
 from replication.runner.execute import CLUSTER_PACKAGES, TIMING_COLUMNS, execute
@@ -164,12 +170,14 @@ def test_an_unreachable_ray_address_is_one_line_at_once(make_cfg, tmp_path):
     pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
     from replication.runner.execute import BackendError
 
+    import ray
+
     runs = expand(make_cfg("hspf_ungm", *TINY))
-    started = time.monotonic()
     with pytest.raises(BackendError) as error:
         execute(runs, Store(tmp_path, "hspf_ungm"), backend="ray", address="127.0.0.1:9", progress=False)
     assert str(error.value).startswith("cannot reach ray at parallel.address=127.0.0.1:9: ")
-    assert "\n" not in str(error.value) and time.monotonic() - started < 15
+    assert "\n" not in str(error.value)
+    assert not ray.is_initialized()  # what makes it quick: ray.init, which retries for minutes, was never called
     assert not (tmp_path / "hspf_ungm").exists()
 
 
@@ -196,3 +204,110 @@ def test_unreachable_scheduler_is_one_clear_error(make_cfg, tmp_path):
         execute(runs, Store(tmp_path, "hspf_ungm"), backend="dask", address="tcp://127.0.0.1:9", progress=False)
     assert "parallel.address=tcp://127.0.0.1:9" in str(error.value) and "\n" not in str(error.value)
     assert not (tmp_path / "hspf_ungm").exists()
+
+
+# four short runs (a ray batch: two per worker), then two that would take minutes, one per worker
+BUSY = ("scale=quick", "n_jobs=2", "experiment.runs.quick=1", "~experiment.methods.grid",
+        "experiment.methods.PF.sweep.n_particles=[100]", "experiment.model.sweep.steps=[10,11,12,13,1000000,1000001]")
+LOCAL_BACKENDS = ["loky", "threading", "dask", "ray"]
+
+
+def local_backend_env(backend: str, request) -> dict | None:
+    """The environment a command running ``backend`` here needs: ray's own (its files in the tests' folder, a
+    token of the test's own: ``ray_env``); None (this one's) for the others."""
+    package = CLUSTER_PACKAGES.get(backend)
+    if package:
+        pytest.importorskip(package, reason=f"{package} is not installed (pip install -e '.[test]')")
+    return request.getfixturevalue("ray_env") if backend == "ray" else None
+
+
+def process_group(leader: int) -> set[int]:
+    """The live processes of ``leader``'s process group."""
+    group = set()
+    for pid in processes():
+        try:
+            if os.getpgid(pid) == leader:
+                group.add(pid)
+        except ProcessLookupError:
+            pass
+    return still_running(group)
+
+
+@NEEDS_PROC
+@pytest.mark.parametrize("backend", LOCAL_BACKENDS)
+def test_one_sigterm_stops_every_local_backend_and_all_it_started(tmp_path, backend, request):
+    """``kill <runner>`` once, with both workers in runs of minutes: the runner exits 143 with its one line,
+    and every process of its group, and every process it started, is gone.  The seconds that takes are
+    measured and printed (a few, on two loaded cores), not asserted: the bound is a generous 30 s."""
+    env = local_backend_env(backend, request)
+    store = tmp_path / "store"
+    with open(tmp_path / "output", "w") as output, open(tmp_path / "errors", "w") as errors:  # not pipes: a
+        runner = subprocess.Popen(  # process left holding one would block its reader
+            command("ungm_horizon", store, tmp_path / "reports", *BUSY, f"parallel.backend={backend}"),
+            cwd=PROJECT_ROOT, stdout=output, stderr=errors, start_new_session=True, env=env)
+    started, deadline = set(), time.monotonic() + 600
+    while len(list(store.glob("ungm_horizon/runs/*.json"))) < 4 and runner.poll() is None:
+        assert time.monotonic() < deadline, "the four short runs were not stored in 10 minutes"
+        started |= descendants(runner.pid)
+        time.sleep(0.05)
+    time.sleep(1.0)  # the two long runs under way
+    started |= descendants(runner.pid) | process_group(runner.pid)
+    assert runner.poll() is None, (tmp_path / "output").read_text()
+    sent = time.monotonic()
+    runner.send_signal(signal.SIGTERM)
+    try:
+        while (runner.poll() is None or still_running(started) or process_group(runner.pid)) \
+                and time.monotonic() - sent < 30:
+            time.sleep(0.05)
+        seconds = time.monotonic() - sent
+        left = still_running(started) | process_group(runner.pid)
+    finally:
+        for pid in still_running(started) | process_group(runner.pid):
+            os.kill(pid, signal.SIGKILL)  # not left to the suite
+    print(f"{backend}: stopped in {seconds:.1f} s after one SIGTERM ({len(started)} processes)")
+    assert not left, {pid: Path(f"/proc/{pid}/cmdline").read_bytes()[:120] for pid in left}
+    err = (tmp_path / "errors").read_text()
+    assert runner.wait(timeout=1) == 143, err
+    assert len(err.strip().splitlines()) == 1 and INTERRUPTED.fullmatch(err.strip()), err
+
+
+def listening(pids: set[int]) -> set[tuple[str, int, str]]:
+    """The (address, port, process name) of every socket ``pids`` listen on."""
+    import psutil
+
+    found = set()
+    for pid in pids:
+        try:
+            process = psutil.Process(pid)
+            found |= {(c.laddr.ip, c.laddr.port, process.name()) for c in process.net_connections(kind="inet")
+                      if c.status == psutil.CONN_LISTEN}
+        except (psutil.NoSuchProcess, psutil.AccessDenied):
+            pass
+    return found
+
+
+def loopback(address: str) -> bool:
+    """127.0.0.0/8 and ::1, and 127.0.0.0/8 written as IPv6 (``::ffff:127.0.0.1``, ray's gRPC servers)."""
+    ip = ipaddress.ip_address(address)
+    return ip.is_loopback or bool(getattr(ip, "ipv4_mapped", None) and ip.ipv4_mapped.is_loopback)
+
+
+@NEEDS_PROC
+@pytest.mark.parametrize("backend", ["dask", "ray"])
+def test_a_local_cluster_listens_on_the_loopback_alone(tmp_path, backend, request):
+    """Every socket the run's processes (the runner, its cluster's scheduler or GCS, raylet and agents, every
+    worker) listen on, sampled while it runs, is on 127.0.0.0/8 or ::1: nothing on another interface, nor
+    on all of them (0.0.0.0, ::)."""
+    pytest.importorskip("psutil", reason="psutil is not installed (distributed's own dependency)")
+    env = local_backend_env(backend, request)
+    runner = subprocess.Popen(
+        command("hspf_ungm", tmp_path / "store", tmp_path / "reports", *TINY, "n_jobs=2", f"parallel.backend={backend}"),
+        cwd=PROJECT_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+    seen, deadline = set(), time.monotonic() + 600
+    while runner.poll() is None and time.monotonic() < deadline:
+        seen |= listening({runner.pid} | descendants(runner.pid))
+        time.sleep(0.2)
+    _, err = runner.communicate(timeout=60)
+    assert runner.returncode == 0, err
+    assert seen, "no listening socket seen: the cluster was not sampled"
+    assert {address for address, *_ in seen if not loopback(address)} == set(), sorted(seen)

@@ -43,6 +43,8 @@ ALLOWED: dict[str, str] = {
                  "the venv included (6 min 56 s at 161a222, measured 2026-11-26)",
     "9 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
                  "(8 min 29 s at 161a222, measured 2026-11-26)",
+    "10 minutes": "README: `make verify`'s default 200 recorded runs on the 2-core machine, re-computed and the "
+                  "verdicts judged again (over 10 minutes, issue 57's new-user test at f29efe1, 2026-11-27)",
     # docs/reproducibility.md, how verify's tolerance was chosen (issue 56), measured 2026-11-27 at b6790c6 on
     # the 2-core AMD EPYC (family 25, model 1): the largest relative difference of a score ...
     "1.8e-14": "... between 75 quick runs as they are and with OpenBLAS's kernel masked (OPENBLAS_CORETYPE)",

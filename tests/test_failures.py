@@ -53,7 +53,7 @@ def test_failed_runs_are_recorded_counted_and_not_rerun(cli, tmp_path):
     assert [p.name.split("__")[0] for p in failed] == ["grid", "grid"] and len(list(runs.glob("*.json"))) == 4
     assert {p.read_text() for p in failed} == {"not finite: rmse=nan\n"}
 
-    report = tmp_path / "reports" / "hspf_ungm@huge_q"  # not the experiment as shipped: a report of its own
+    report = tmp_path / "reports" / "quick" / "hspf_ungm@huge_q"  # not the experiment as shipped: its own report
     assert "2 runs failed: not finite: rmse=nan" in (report / "index.html").read_text()
     assert json.loads((report / "summary.json").read_text())["failed"] == {"not finite: rmse=nan": 2}
     table = pd.read_csv(report / "table1_rmse.csv")  # PF and HSPF from their 2 runs each, no grid row

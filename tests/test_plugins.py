@@ -240,16 +240,23 @@ def _tree_digest(folder: Path) -> str:
     return digest.hexdigest()
 
 
+def readme_command(section: str) -> str:
+    """The shell block of the README's section ``section``."""
+    text = (PROJECT_ROOT / "README.md").read_text().split(f"\n## {section}\n", 1)[1].split("\n## ", 1)[0]
+    return re.search(r"```sh\n(.*?)```", text, re.DOTALL)[1]
+
+
 @pytest.mark.e2e
 def test_the_tutorial_runs_the_sixth_paper_and_judges_it_with_the_package_untouched(tmp_path):
-    """docs/tutorial_your_method.md's commands, in order, in a fresh project folder holding a copy of the
-    example: the APF beside two shipped experiments (the UNGM, and real video), then its own experiment and
-    claim judged; then an edit of its source reruns exactly its runs."""
+    """docs/tutorial_your_method.md's commands, in order, then the README's, in a fresh project folder holding
+    a copy of the example (as a clone's folder does): the APF beside two shipped experiments (the UNGM, and
+    real video), then its own experiment and claim judged; then an edit of its source reruns exactly its runs."""
     package = _tree_digest(PACKAGE_DIR)
     project = tmp_path / "project"
     shutil.copytree(EXAMPLE, project / "examples" / "auxiliary_pf", ignore=shutil.ignore_patterns("__pycache__"))
     (tmp_path / "shared").symlink_to(PROJECT_ROOT.parent / "shared")  # ../shared beside the project, as here
-    script = "\n".join(BASH.findall((PROJECT_ROOT / "docs" / "tutorial_your_method.md").read_text()))
+    script = "\n".join([*BASH.findall((PROJECT_ROOT / "docs" / "tutorial_your_method.md").read_text()),
+                        readme_command("Your own method")])  # the README's, as written, from the same folder
     env = {**os.environ, "PATH": os.pathsep.join((str(Path(sys.executable).parent), os.environ["PATH"]))}
     env.pop("PYTHONPATH", None)
     done = subprocess.run(["bash", "-euo", "pipefail", "-c", script], cwd=project, env=env, capture_output=True,
@@ -257,9 +264,11 @@ def test_the_tutorial_runs_the_sixth_paper_and_judges_it_with_the_package_untouc
     assert done.returncode == 0, done.stderr[-3000:]
     reports = project / "reports"
     for name in ("hspf_ungm@apf", "hspf@apf"):
-        page = (reports / name / "index.html").read_text()
+        page = (reports / "quick" / name / "index.html").read_text()
         assert "APF" in page, name
-    own = [p for p in reports.glob("apf_ungm@*") if p.is_dir()]
+    readmes = [p for p in (reports / "quick").glob("hspf_ungm@*") if p.name != "hspf_ungm@apf"]  # a digest
+    assert len(readmes) == 1 and "APF" in (readmes[0] / "index.html").read_text()
+    own = [p for p in (reports / "quick").glob("apf_ungm@*") if p.is_dir()]
     assert len(own) == 1
     import json
 

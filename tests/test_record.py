@@ -318,14 +318,48 @@ def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsy
         (tmp_path / name).mkdir()
         c.to_csv(tmp_path / name / "claims.csv", index=False)
         s.to_csv(tmp_path / name / "summary.csv", index=False)
-    diff([str(tmp_path / "a"), str(tmp_path / "b")])
+    with pytest.raises(SystemExit) as status:
+        diff([str(tmp_path / "a"), str(tmp_path / "b")])
+    assert status.value.code == 1  # as diff(1): something differs
     out = capsys.readouterr().out
+    assert f"A: {tmp_path / 'a'}: a drawn report, read as it is" in out
     assert "p.b: verdict 'inconclusive' -> 'does not hold'" in out and "p.a:" not in out
     assert "p 1 e PF rmse N=100: ours '4.1 [3.9, 4.3]' -> '4.2 [4.0, 4.4]'" in out
     assert "p.c: robustness 'one reading' -> 'no reading moves the verdict '" in out
     assert "3 claims: 1 changed verdict, 2 changed at all; 1 cells: 1 changed" in out  # p.c's verdict held
-    with pytest.raises(SystemExit):
+    diff([str(tmp_path / "a"), str(tmp_path / "a")])  # the same: nothing differs, exit status 0
+    assert "3 claims: 0 changed verdict, 0 changed at all; 1 cells: 0 changed" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as status:
         diff([str(tmp_path / "a"), str(tmp_path / "nothing")])
+    err = capsys.readouterr().err
+    assert status.value.code == 2 and "nothing: no such folder" in err and "an installed copy ships none" in err
+
+
+def test_diff_of_two_records_names_them_as_given_and_reads_pages_drawn_from_the_same_record(make_cfg, tmp_path,
+                                                                                          monkeypatch, capsys):
+    """Where reports/record holds a record's pages as this code draws them, diff reads them; another record's
+    pages are drawn into a scratch folder that is never named (it is gone afterwards), with a bar."""
+    import shutil
+
+    from replication.paths import HOME_VARIABLE
+    from replication.report.__main__ import main as report
+    from replication.report.diff import main as diff
+
+    cfg, _, _ = stored(make_cfg, tmp_path, "gps_qmcpf", UNGM)
+    write([cfg], tmp_path / "experiments", tmp_path / "record")
+    shutil.copytree(tmp_path / "record", tmp_path / "other")  # the same runs in another record (written later)
+    manifest = json.loads((tmp_path / "other" / "manifest.json").read_text())
+    manifest["experiments"]["gps_qmcpf"]["written"] = "2099-01-01"
+    (tmp_path / "other" / "manifest.json").write_text(json.dumps(manifest))
+    monkeypatch.setenv(HOME_VARIABLE, str(tmp_path))  # the project: reports/ and record/ in it
+    report(["source=record", "pdf=false", "progress=false"])  # reports/record, drawn from record/
+    capsys.readouterr()
+    diff(["record", "other"])  # the same runs: nothing differs (no exit status 1)
+    out, err = capsys.readouterr()
+    assert f"A: record: a record whose pages {tmp_path / 'reports' / 'record'} holds, drawn from it" in out
+    assert "B: other: a record of 1 experiments and multiverses: drawing its pages" in out and "pages: 100%" in err
+    assert "0 changed verdict, 0 changed at all" in out
+    assert "diff-" not in out + err  # no scratch folder (tempfile's diff-*) named
 
 
 def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_record_as_from_the_store(tmp_path):
@@ -373,7 +407,8 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     partial = write([cfg], tmp_path / "store", tmp_path / "partial").experiments["hspf_test_readings"]
     assert list(partial.files) == ["hspf_test_readings/universes/default.parquet"]
     # the command goes on where a record stops: a universe recorded under this code's keys is not run again
-    from replication.cli import multiverse_forecast, recorded_universes
+    from replication.cli import multiverse_forecast, universes_left
+    from replication.record.layer import recorded_universes
 
     assert not record.universe(multiverse.name, larger.name).holds(multiverse.runs["default", "hspf_ungm"])
     for folder, scale, skip, expected in (("partial", "paper", True, ["default"]), ("record", "paper", True,
@@ -385,5 +420,8 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     cfg.record, cfg.scale, cfg.skip_recorded = str(tmp_path / "partial"), "paper", True
     said = multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2)
     assert said.startswith("hspf_test_readings: 1 runs to compute, about ") and "1 worker(s)" in said, said
+    left = universes_left(cfg, multiverse, recorded_universes(cfg, multiverse))  # what dry_run=true counts
+    assert {where: len(runs) for where, runs in left.items()} == {
+        "stored": len(larger_runs) - 1, "read from the record": 0, "to compute": 1}
     cfg.record = str(tmp_path / "record")
     assert multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2).endswith(": 0 runs to compute")

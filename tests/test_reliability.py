@@ -21,7 +21,7 @@ from replication.cli import check_request
 from replication.errors import ConfigError
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute, forecast, parallel_backend, schedule
-from replication.runner.store import Store
+from replication.runner.store import CHECKSUM, Store
 from replication.runner.validate import prepare
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
@@ -34,8 +34,9 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def stored_table(store_root: Path, experiment: str) -> pd.DataFrame:
+    """The store's files as written (each record's checksum left out: it hashes the timings too)."""
     records = [json.loads(p.read_text()) for p in (store_root / experiment / "runs").glob("*.json")]
-    return deterministic_columns(pd.DataFrame(records))
+    return deterministic_columns(pd.DataFrame(records).drop(columns=CHECKSUM))
 
 
 def command(experiment: str, store: Path, reports: Path, *args: str) -> list[str]:
@@ -150,7 +151,7 @@ def test_a_full_disk_is_one_line_naming_the_store_and_keeps_what_was_stored(make
     prints it as one line); no temporary file is left, and the same command then completes the rest."""
     import errno
 
-    import replication.runner.store as store_module
+    import replication.atomic as atomic_module
     from replication.runner.store import StoreFull
 
     runs = expand(make_cfg("hspf_ungm", "scale=quick", "experiment.runs.quick=2"))
@@ -163,7 +164,7 @@ def test_a_full_disk_is_one_line_naming_the_store_and_keeps_what_was_stored(make
             raise OSError(errno.ENOSPC, "No space left on device", str(path))
         return open(path, mode, *args, **kwargs)
 
-    monkeypatch.setattr(store_module, "open", filling, raising=False)
+    monkeypatch.setattr(atomic_module, "open", filling, raising=False)
     with pytest.raises(StoreFull) as full:
         execute(runs, store, n_jobs=1, backend="threading", progress=False)
     message = str(full.value)
@@ -340,14 +341,12 @@ OTB_SCENE = ("experiment=ism_pf_otb", "experiment.model.sweep.scene=[Girl]")
     ],
 )
 def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args, message):
-    started = time.perf_counter()
-    result = cli(*args, "scale=quick", timeout=60)
-    elapsed = time.perf_counter() - started
+    """(What makes them quick, no heavy import before a config error, is tests/test_bad_input.py's.)"""
+    result = cli(*args, "scale=quick", timeout=300)
     assert result.returncode == 2, result.stderr
     assert message in result.stderr
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert not (tmp_path / "experiments").exists()  # no work started
-    assert elapsed < 20, elapsed  # interpreter start and imports on a loaded 2-core machine; the check is below
 
 
 @pytest.mark.parametrize(
@@ -366,12 +365,19 @@ def test_bad_configs_fail_at_once_in_one_line_naming_the_key(cli, tmp_path, args
         ("hspf_ungm", ("n_jobs=0",), "n_jobs"),
     ],
 )
-def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key):
+def test_config_checks_fail_before_any_scene_is_built(make_cfg, monkeypatch, experiment, overrides, key):
+    """What would make a check slow is building a scene (reading a sequence's frames, drawing a synthetic one):
+    every check fails before the first is built."""
+    from replication.scenes import factory
+
+    def built(spec):
+        raise AssertionError(f"a scene was built before the check: {spec.get('name')}")
+
+    monkeypatch.setattr(factory, "build_sequence", built)
+    factory._cached.cache_clear()
     cfg = make_cfg(experiment, "scale=quick", *overrides)
-    started = time.perf_counter()
     with pytest.raises(ConfigError) as error:
         prepare(cfg)
-    assert time.perf_counter() - started < 1.0
     assert key in str(error.value) and "\n" not in str(error.value)
 
 
@@ -384,10 +390,9 @@ def test_config_checks_take_under_a_second(make_cfg, experiment, overrides, key)
     ],
 )
 def test_hydra_override_errors_are_one_line(argv, message):
-    started = time.perf_counter()
+    """(That they come before any heavy import is tests/test_bad_input.py's, in a fresh interpreter.)"""
     with pytest.raises(ConfigError) as error:
         check_request(argv)
-    assert time.perf_counter() - started < 1.0
     assert message in str(error.value) and "\n" not in str(error.value)
 
 

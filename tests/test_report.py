@@ -223,14 +223,38 @@ def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
 
 def test_scale_changes_lists_what_quick_changes_from_the_config():
     from replication.report.pages.scale import scale_changes, scale_note
+    from replication.scales import at_scale
 
     config = {"quick_frames": {"paper": None, "quick": 100},  # a YAML anchor, not a setting
               "runs": {"paper": 100, "quick": 10},
               "scenes": {"Girl": {"last": {"paper": None, "quick": 100}}, "b": {"frames": {"paper": 5, "quick": 5}}},
-              "methods": {"PF": {"n_particles": 10}}}
-    assert scale_changes(config) == ["runs: 100 -> 10", "scene Girl last frame: all -> 100"]
+              "methods": {"PF": {"n_particles": 10, "sweep": {"N": {"paper": [10, 100], "quick": [10, 50]}}}}}
+    assert scale_changes(at_scale(config, "paper"), at_scale(config, "quick")) == [
+        "runs: 100 -> 10", "scene Girl last frame: all -> 100", "methods PF sweep N: [10, 100] -> [10, 50]"]
     assert scale_note("paper") is None
     assert "(runs: 100 -> 10)" in scale_note("quick", ["runs: 100 -> 10"])
+
+
+def test_the_quick_banner_of_a_users_own_sequences_lists_them_not_the_shipped_ones(make_cfg, tmp_path):
+    """hspf on a sequence of one's own (a copy of Girl named MyClip): its page's banner names MyClip's frames,
+    not the six shipped sequences it replaced."""
+    from conftest import PROJECT_ROOT
+
+    from replication.report.pages.scale import scale_changes
+    from replication.runner.results import Results
+    from replication.runner.store import Store
+    from replication.scenes.otb import OTB_ROOT
+
+    girl = PROJECT_ROOT / OTB_ROOT / "Girl"
+    if not girl.is_dir():
+        pytest.skip(f"OTB data not at {girl}")
+    (tmp_path / "otb").mkdir()
+    (tmp_path / "otb" / "MyClip").symlink_to(girl.resolve())
+    cfg = make_cfg("hspf", "scale=quick", f"data.otb={tmp_path / 'otb'}", "sequences=[MyClip]")
+    results = Results.of(cfg, [], Store(tmp_path / "experiments", "hspf"))
+    changes = scale_changes(results.at_paper_scale, results.experiment)
+    assert [change for change in changes if change.startswith("scene")] == ["scene MyClip last frame: all -> 100"]
+    assert any(change.startswith("runs: ") for change in changes)
 
 
 def test_every_template_escapes_what_a_config_puts_in_a_page():

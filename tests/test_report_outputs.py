@@ -99,21 +99,21 @@ def test_summary_has_one_row_per_published_cell_with_ours_or_a_reason(published)
     assert reasons[8] == "not run at this scale: trk at scale=paper (ran at quick)"
     assert list(table["reason_kind"])[1:4] == ["method not reproduced", "condition not reproduced", "not run yet"]
     assert counts(table)["reasons"]["not run yet"] == 1  # counted by kind, not by cutting the text at a colon
-    assert table.iloc[8]["link"] == "trk/index.html#unmatched"
+    assert table.iloc[8]["link"] == "quick/trk/index.html#unmatched"  # its page at the scale it ran
     assert all(bool(v) != bool(r) for v, r in zip(table["verdict"], table["reason"]))  # one or the other
 
 
 def test_index_shows_the_summary_from_the_experiments_summary_json(tmp_path, published):
     reports = tmp_path / "reports"
-    (reports / "gps_qmcpf").mkdir(parents=True)
+    (reports / "quick" / "gps_qmcpf").mkdir(parents=True)
     Summary("gps_qmcpf", "QMC filters", "qmc", "quick", 4, 4, cells=(
         _cell(published, 0, table_name="table1_rmse", ours=4.0, ci_low=3.5, ci_high=4.5, verdict=REPRODUCED),
-    )).write(reports / "gps_qmcpf")
+    )).write(reports / "quick" / "gps_qmcpf")
     page = write_index(reports, tmp_path / "published.csv")
     html = page.read_text()
     body = html.split('<table id="cells"', 1)[1].split("</table>", 1)[0]
     assert body.count("<tr") == 1 + len(published)  # header + one row per cell
-    assert 'href="gps_qmcpf/index.html#table1_rmse"' in body and "4 [3.5, 4.5]" in body
+    assert 'href="quick/gps_qmcpf/index.html#table1_rmse"' in body and "4 [3.5, 4.5]" in body
     assert "no value in the paper: failed (reported as error)" in body
     assert len(pd.read_csv(reports / "summary.csv", keep_default_na=False)) == len(published)
 
@@ -213,8 +213,8 @@ REMOTE = re.compile(r"^\s*(https?:|//|ftp:)", re.IGNORECASE)
 
 def test_every_page_is_self_contained(reports):
     pages = sorted(reports.rglob("*.html"))
-    assert {p.relative_to(reports).as_posix() for p in pages} >= {"index.html", "gps_qmcpf/index.html",
-                                                                   "hspf_ungm/index.html"}
+    assert {p.relative_to(reports).as_posix() for p in pages} >= {"index.html", "quick/gps_qmcpf/index.html",
+                                                                   "quick/hspf_ungm/index.html"}
     for page in pages:
         parser = _Links()
         parser.feed(page.read_text())
@@ -242,12 +242,12 @@ def test_summary_in_the_index_covers_every_published_cell(reports):
     assert (summary["verdict"] != "").ne(summary["reason"] != "").all()
     rmse = summary[(summary["paper"] == "gps_qmcpf") & (summary["table"] == "1")
                    & (summary["metric"] == "rmse")]
-    assert (rmse["verdict"] != "").all() and rmse["link"].str.startswith("gps_qmcpf/index.html#").all()
+    assert (rmse["verdict"] != "").all() and rmse["link"].str.startswith("quick/gps_qmcpf/index.html#").all()
     html = (reports / "index.html").read_text()
     assert 'href="replication.pdf"' in html and 'id="cells"' in html
     assert html.index('id="scorecard"') < html.index('id="cells"')  # the claims come first
     assert 'id="scale-banner"' in html and "make replicate SCALE=paper" in html  # quick scale, said up front
-    assert 'id="scale-banner"' in (reports / "gps_qmcpf" / "index.html").read_text()
+    assert 'id="scale-banner"' in (reports / "quick" / "gps_qmcpf" / "index.html").read_text()
 
 
 def test_claims_csv_has_one_row_per_claim_with_a_verdict_and_its_interval(reports):
@@ -270,7 +270,7 @@ def test_claims_csv_has_one_row_per_claim_with_a_verdict_and_its_interval(report
 def test_no_interval_in_the_reports_leaves_its_metrics_range(reports):
     from replication.evidence.quantities import quantity
 
-    for folder in (reports / "gps_qmcpf", reports / "hspf_ungm"):
+    for folder in (reports / "quick" / "gps_qmcpf", reports / "quick" / "hspf_ungm"):
         for spec in experiment_configs()[folder.name]["report"].get("tables", []):
             path = folder / f"{spec['name']}.csv"
             if "metric" not in spec or not path.exists():
@@ -336,7 +336,7 @@ def _valid_png(path: Path) -> tuple[int, int]:
 
 @pytest.mark.skipif(browser() is None, reason="no Chromium on the PATH (Debian: apt-get install chromium)")
 def test_pages_in_headless_chromium(reports, tmp_path):
-    pages = ((reports / "index.html", "index.png"), (reports / "gps_qmcpf" / "index.html", "gps.png"))
+    pages = ((reports / "index.html", "index.png"), (reports / "quick" / "gps_qmcpf" / "index.html", "gps.png"))
     for page, shot in pages:
         seen = open_in_browser(page, tmp_path / shot)
         assert seen["console"] == [], f"{page}: {seen['console']}"

@@ -20,7 +20,7 @@ from replication.errors import ConfigError
 from replication.runner.config import expand
 from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.provenance import code_digest
-from replication.runner.store import Store
+from replication.runner.store import CHECKSUM, Store, checksum
 from replication.seeding import seed_sequence
 
 
@@ -99,7 +99,7 @@ def test_expansion_is_method_by_condition_by_repetition(make_cfg):
         ("PF", 500), ("PF", 200), ("PF", 100), ("grid", None)
     }
     assert len({r.run_id for r in runs}) == len(runs)
-    paper = expand(make_cfg("gps_qmcpf"))
+    paper = expand(make_cfg("gps_qmcpf", "scale=paper"))  # quick is the default
     assert len(paper) == 16 * 100
 
 
@@ -228,9 +228,9 @@ def test_store_write_is_atomic(tmp_path, make_cfg):
     with pytest.raises(TypeError):
         store.write(run, {"x": Unserialisable()})
     assert not store.has(run)
-    assert list(store.directory.iterdir()) == []  # no partial file, no stray temporary
+    assert [p for p in tmp_path.rglob("*") if p.is_file()] == []  # no partial file, no stray temporary
     store.write(run, {"x": 1.0})
-    assert json.loads(store.path(run).read_text()) == {"x": 1.0}
+    assert json.loads(store.path(run).read_text()) == {"x": 1.0, CHECKSUM: checksum({"x": 1.0})}
 
 
 @pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o002, 0o664), (0o077, 0o600)])
@@ -274,7 +274,7 @@ def test_interrupted_job_resumes_to_the_same_table(tmp_path):
 
     def table(store):
         records = [json.loads(p.read_text()) for p in (store / "ungm_horizon" / "runs").glob("*.json")]
-        return deterministic_columns(pd.DataFrame(records))
+        return deterministic_columns(pd.DataFrame(records).drop(columns=CHECKSUM))  # it hashes the timings too
 
     pd.testing.assert_frame_equal(table(tmp_path / "a"), table(tmp_path / "b"))
 
@@ -284,7 +284,7 @@ def test_cli_end_to_end_writes_report(cli, tmp_path):
     result = cli("experiment=gps_qmcpf", "experiment.also=[]", *SMALL)  # not its helicopter half
     assert result.returncode == 0, result.stderr
     assert "48 runs computed, 0 already stored" in result.stdout
-    out = tmp_path / "reports" / "gps_qmcpf"
+    out = tmp_path / "reports" / "quick" / "gps_qmcpf"  # the quick scale's page, apart from the paper scale's
     table = pd.read_csv(out / "table1_rmse.csv")
     assert list(table["condition"].fillna("-")) == ["N=500", "N=200", "N=100"] * 5 + ["-"]
     assert np.all(table["runs"] == 3)
@@ -331,7 +331,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
     )
     assert report.returncode == 0, report.stderr
     assert "n_points=3201: 3 of 9 runs not stored" in report.stderr  # a value never run is named, not drawn
-    (out,) = (tmp_path / "reports").glob("ungm_horizon@*/sweeps")  # T=10 only: not the experiment as shipped
+    (out,) = (tmp_path / "reports" / "quick").glob("ungm_horizon@*/sweeps")  # T=10 only: not as shipped
     table = pd.read_csv(out / "experiment.methods.grid.n_points.csv").set_index("condition")
     records = pd.DataFrame([json.loads(p.read_text()) for p in (tmp_path / "experiments" / "ungm_horizon" / "runs").glob("*.json")])
     grid = records[records["method"] == "grid"]  # two configs, 3 runs each
@@ -353,7 +353,7 @@ def test_a_multirun_draws_its_sweep_at_its_end(cli, tmp_path):
     result = cli("-m", "experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=5", "experiment.methods.grid.n_points=201",
                  "experiment.methods.PF.n_particles=50,100")
     assert result.returncode == 0, result.stderr
-    (sweeps,) = (tmp_path / "reports").glob("hspf_ungm@*/sweeps")  # its grid of 201 points: not as shipped
+    (sweeps,) = (tmp_path / "reports" / "quick").glob("hspf_ungm@*/sweeps")  # a grid of 201 points: not as shipped
     page = sweeps / "experiment.methods.PF.n_particles.html"
     assert page.exists() and "sweep: " in result.stdout
     table = pd.read_csv(page.with_suffix(".csv"))

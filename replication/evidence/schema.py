@@ -15,6 +15,7 @@ from collections import Counter
 from enum import Enum
 from pathlib import Path
 
+from replication import atomic
 from replication.evidence.claims import Result
 from replication.evidence.tables import CellResult
 from replication.evidence.verdict import Verdict
@@ -59,7 +60,7 @@ class Summary:
 
     def write(self, folder: Path) -> Path:
         path = Path(folder) / "summary.json"
-        path.write_text(json.dumps(dump(self), indent=1))
+        atomic.write_text(path, json.dumps(dump(self), indent=1))
         return path
 
     @classmethod

@@ -21,26 +21,36 @@ import yaml
 from replication.evidence.schema import Summary
 from replication.evidence.tables import KEYS, CellResult, matched
 from replication.paths import CONF_DIR, experiment_names
+from replication.scales import SCALES, page_link, report_folder
 
 # -- the summary of every published cell --------------------------------------------------------------
 
 
-def load_summaries(reports: Path, own: bool = False) -> dict[str, Summary]:
-    """Each shipped experiment's ``summary.json`` under ``reports``, by experiment name (configs' order); with
-    ``own``, instead the reports of users' own data or settings (``<experiment>@<label>``), which the
-    scorecard and the summary of published cells never read.  One that an older version wrote in another
-    schema is left out with one line on stderr (redraw it)."""
+def load_summaries(reports: Path, own: bool = False, scales: tuple[str, ...] = SCALES) -> dict[str, Summary]:
+    """Each shipped experiment's ``summary.json`` under ``reports``, by experiment name (configs' order), at
+    the first of ``scales`` that has one (:func:`~replication.scales.report_folder`: the paper scale's before
+    the quick one's, so a quick run never hides a paper-scale verdict); with ``own``, instead the reports of
+    users' own data or settings (``<experiment>@<label>``), which the scorecard and the summary of published
+    cells never read.  One that an older version wrote in another schema, or at another scale than its
+    folder's, is left out with one line on stderr (redraw it)."""
     summaries = {}
-    names = sorted(p.parent.name for p in Path(reports).glob("*@*/summary.json")) if own else experiment_names()
-    for name in names:
-        path = Path(reports) / name / "summary.json"
-        if not path.exists():
+    folders = [report_folder(reports, "", scale) for scale in scales]  # every scale's reports
+    names = sorted({p.parent.name for f in folders for p in f.glob("*@*/summary.json")}) if own else experiment_names()
+    for name, scale in ((name, scale) for name in names for scale in scales):
+        path = report_folder(reports, name, scale) / "summary.json"
+        if name in summaries or not path.exists():
             continue
+        redraw = f"redraw it: pf-replicate report experiment={name.split('@')[0]} scale={scale}"
         try:
-            summaries[name] = Summary.read(path)
+            summary = Summary.read(path)
         except (KeyError, TypeError, ValueError) as error:
-            print(f"skipped: {path} is in an older schema ({error!r}); redraw it: python -m replication.report "
-                  f"experiment={name}", file=sys.stderr)
+            print(f"skipped: {path} is in an older schema ({error!r}); {redraw}", file=sys.stderr)
+            continue
+        if summary.scale != scale:  # written before the scales' reports lived apart
+            print(f"skipped: {path} is at the {summary.scale} scale, in the {scale} scale's folder; {redraw}",
+                  file=sys.stderr)
+            continue
+        summaries[name] = summary
     return summaries
 
 
@@ -102,7 +112,7 @@ def summary_table(
             if entry.our_condition != cell["condition"]:  # ours is named otherwise: a stand-in scene, an unstated N
                 row["our_condition"] = entry.our_condition
             row["runs"] = str(entry.runs)
-            row["link"] = f"{name}/index.html#{entry.table_name}"
+            row["link"] = f"{page_link(name, summaries[name].scale)}#{entry.table_name}"
             row["link_text"] = f"{name}: {entry.table_name}"
             row["also"] = "; ".join(
                 f"{e.table_name}{' ' + e.our_condition if e.our_condition else ''}: {e.ours}, {_verdict(e)[1]}"
@@ -111,7 +121,7 @@ def summary_table(
         else:
             unmatched, name = _why_not(cell, summaries, configs, scene_notes)
             row["reason"], row["reason_kind"] = str(unmatched), unmatched.kind
-            row["link"] = f"{name}/index.html#unmatched" if name in summaries else ""
+            row["link"] = f"{page_link(name, summaries[name].scale)}#unmatched" if name in summaries else ""
             row["link_text"] = name if name in summaries else ""
         rows.append(row)
     columns = [*KEYS, "note", "paper_value", "ours", "runs", "our_condition", "outcome", "verdict", "tag", "reason",

@@ -15,6 +15,7 @@ import json
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
+from replication import atomic
 from replication.runner.machine import Machine
 
 MANIFEST = "manifest.json"
@@ -65,6 +66,11 @@ class Entry:
             return None
         first, last = (datetime.datetime.fromisoformat(t) for t in (self.first_computed, self.last_computed))
         return round((last - first).total_seconds() / 60, 1)
+
+    def damaged(self, record: Path) -> list[str]:
+        """Its files whose bytes no longer have the SHA-256 it gives them (or that are gone)."""
+        return [file for file, digest in self.files.items()
+                if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
 
     def replacing(self, earlier: "Entry") -> "Entry":
         """This entry, keeping what ``earlier`` (the recording it replaces) took."""
@@ -119,15 +125,13 @@ class Manifest:
 
     def write(self, record: Path) -> Path:
         path = Path(record) / MANIFEST
-        path.parent.mkdir(parents=True, exist_ok=True)
         data = {"scale": self.scale, "experiments": {k: asdict(v) for k, v in sorted(self.experiments.items())}}
-        path.write_text(json.dumps(data, indent=1) + "\n")
+        atomic.write_text(path, json.dumps(data, indent=1) + "\n")
         return path
 
     def damaged(self, record: Path) -> list[str]:
         """The files whose bytes no longer have the manifest's SHA-256 (or that are gone)."""
-        return [file for entry in self.experiments.values() for file, digest in entry.files.items()
-                if not (Path(record) / file).exists() or sha256(Path(record) / file) != digest]
+        return [file for entry in self.experiments.values() for file in entry.damaged(record)]
 
 
 def read_profile(record: Path) -> dict | None:

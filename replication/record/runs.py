@@ -19,6 +19,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from replication import atomic
 from replication.condition import PREFIX
 from replication.run import Run
 from replication.runner.results import SERIES, parameters
@@ -77,8 +78,7 @@ def runs_table(rows: list[dict]) -> pa.Table:
 
 def write_table(table: pa.Table, path: Path) -> None:
     """``table`` as Parquet, zstd-compressed; the same table gives the same bytes."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    pq.write_table(table, path, compression="zstd", compression_level=9)
+    atomic.save(path, lambda tmp: pq.write_table(table, tmp, compression="zstd", compression_level=9))
 
 
 def read_rows(path: Path) -> list[dict]:

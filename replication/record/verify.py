@@ -50,7 +50,9 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 from scipy import stats
+from tqdm.auto import tqdm
 
+from replication import atomic
 from replication.condition import PREFIX
 from replication.errors import ConfigError, fail
 from replication.evidence.statistics import Estimate
@@ -325,7 +327,8 @@ def verify(cfgs: list, record: Record, n: int | None, cheapest: bool, n_jobs: in
     """Re-compute a sample of the record's runs of ``cfgs`` (composed at the paper scale: experiments, and
     multiverses, each universe a stratum), each distinct run once, and grade them; first say how many and
     roughly how long (their recorded times, and :data:`START` per experiment), and ``then`` what follows."""
-    recorded = {name: pairs for cfg in cfgs for name, pairs in strata(cfg, record).items() if pairs}
+    reading = tqdm(cfgs, desc="reading the record", unit="experiment", disable=not progress, mininterval=1.0)
+    recorded = {name: pairs for cfg in reading for name, pairs in strata(cfg, record).items() if pairs}
     chosen = sample(recorded, n, cheapest)
     distinct = {(run.experiment, run.run_id, row["run_key"]): (run, row) for run, row in chosen}
     held: dict[tuple[str, str, str], list[str]] = {}  # each distinct run: the strata whose recorded runs hold it
@@ -419,8 +422,7 @@ def write_recomputed(found: dict[str, dict], out: Path) -> None:
     """Write :func:`recomputed`'s finding for the index and print it: a line per diverged run and the counts.
     A run beyond the spread is a finding the index shows at its top, not a failed command (make replicate
     goes on)."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(found, indent=1) + "\n")
+    atomic.write_text(out, json.dumps(found, indent=1) + "\n")
     lines = [line for entry in found.values() for line in entry["lines"]]
     print(*lines, sep="\n", end="\n" if lines else "")
     compared = sum(entry["compared"] for entry in found.values())
@@ -469,6 +471,8 @@ def main(argv: list[str], verdicts: Callable[[Path, Path, list[str], int], list[
         missing = sorted(set(names) - set(manifest.experiments))
         if missing:
             fail(f"the record holds no {missing[0]!r}; it holds {', '.join(sorted(manifest.experiments))}")
+        if options.get("against") is None:
+            print(sampling(manifest, names, n), flush=True)
         scale = options.get("scale", "paper")
         cfgs = [compose("config", overrides=[f"experiment={name}", f"scale={scale}", *paths, *changes])
                 for name in names]
@@ -490,6 +494,17 @@ def main(argv: list[str], verdicts: Callable[[Path, Path, list[str], int], list[
     moved = rejudged(folder, verification, n_jobs, verdicts) if verdicts else []
     if verification.failing or moved:
         sys.exit(1)
+
+
+def sampling(manifest: Manifest, names: list[str], n: int | None) -> str:
+    """The line verify says before it reads the record: how many runs it samples of how many, from how many
+    strata (each gives at least one, so a small ``N`` samples one run per experiment and universe)."""
+    strata_count = sum(manifest.experiments[name].universes or 1 for name in names)
+    total = sum(manifest.experiments[name].runs for name in names)
+    size = "all" if n is None else f"about {max(n, strata_count):,}"
+    return (f"verify: {size} of the record's {total:,} runs of {len(names)} experiments and multiverses, each of "
+            f"their {strata_count} experiments and universes at least one (experiment=a,b for fewer); reading them "
+            "from the record first")
 
 
 def rejudged(folder: Path, verification: Verification, n_jobs: int,

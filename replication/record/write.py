@@ -6,7 +6,11 @@ runs with their reason) into ``<record>/<experiment>/runs.parquet`` (:mod:`.runs
 figures draw into ``<record>/<experiment>/curves/<figure>.parquet``; a paper's multiverse
 (``<paper>_readings``) universe by universe into ``<record>/<paper>_readings/universes/<universe>.parquet``.  An
 experiment with a run neither stored nor failed is not written (run it first: the record holds whole
-experiments), and the manifest (:mod:`.manifest`) is updated for those written.  A table whose bytes do
+experiments), and the manifest (:mod:`.manifest`) is updated for those written.  A run the store lacks that
+the record already holds as this code computes it (a paper-scale request read it from the record,
+:mod:`.layer`) keeps its recorded row; an experiment none of whose runs the store holds stays as recorded,
+and one with curve figures is recorded again only from a store that holds every run (the record keeps no
+per-frame series to draw its curves from).  A table whose bytes do
 not change keeps its manifest entry, date and commit, so regenerating the record changes only what
 changed.
 """
@@ -22,16 +26,15 @@ from omegaconf import DictConfig
 from replication.errors import ConfigError
 from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.tables import TableKind
+from replication.record.layer import SCALE, checked
 from replication.record.manifest import Entry, Manifest
 from replication.record.runs import (
-    CURVES_DIR, RUNS_FILE, UNIVERSE, read_rows, row, runs_table, universe_path, write_table,
+    CURVES_DIR, RUNS_FILE, UNIVERSE, Record, read_rows, row, runs_table, universe_path, write_table,
 )
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
 from replication.runner.multiverse import load
 from replication.runner.store import CorruptRecord, Store
-
-SCALE = "paper"
 
 
 def kept_series(experiment: dict) -> tuple[str, ...]:
@@ -40,10 +43,12 @@ def kept_series(experiment: dict) -> tuple[str, ...]:
     return tuple(sorted({s for spec in tables for s in TableKind.of(spec, experiment, None).reads}))
 
 
-def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...]) -> tuple[list[dict], int]:
-    """The rows of ``runs`` from ``store`` (a failed run with its reason), and how many it holds neither
-    stored nor failed."""
-    rows, missing = [], 0
+def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...],
+                recorded: dict[str, dict] | None = None) -> tuple[list[dict], int, int]:
+    """The rows of ``runs`` from ``store`` (a failed run with its reason), else from ``recorded`` (run id ->
+    the record's row of it, :func:`recorded_rows`); how many neither holds, and how many came from
+    ``recorded``."""
+    rows, missing, from_record = [], 0, 0
     for run in runs:
         try:
             stored = store.read(run)
@@ -51,11 +56,22 @@ def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...]) -> tuple
             stored = None
         failed = store.failure_path(run)
         failure = failed.read_text().strip() if stored is None and failed.exists() else None
-        if stored is None and failure is None:
+        if stored is None and failure is None and run.run_id in (recorded or {}):
+            rows.append(recorded[run.run_id])
+            from_record += 1
+        elif stored is None and failure is None:
             missing += 1
         else:
             rows.append(row(run, stored, failure, series))
-    return rows, missing
+    return rows, missing, from_record
+
+
+def recorded_rows(record: Path, runs: list[Run]) -> dict[str, dict]:
+    """Run id -> the row of each of ``runs`` the record at ``record`` holds as this code computes it (its
+    recorded key the run's), where the record's files of their experiment are sound (:func:`.layer.checked`)."""
+    if not runs or checked(record, runs[0].experiment) is None:
+        return {}
+    return {run.run_id: found for run, found in Record(record).found(runs) if found["run_key"] == run.key}
 
 
 def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
@@ -64,8 +80,15 @@ def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
     when the store does not hold them all."""
     name, runs = cfg.experiment.name, expand(_at_paper_scale(cfg))
     experiment, store = experiment_at_scale(cfg), Store(store_root, cfg.experiment.name)
-    rows, missing = stored_rows(runs, store, kept_series(experiment))
+    rows, missing, from_record = stored_rows(runs, store, kept_series(experiment), recorded_rows(record, runs))
     _complete(name, missing, len(runs))
+    if from_record == len(runs):  # nothing new in the store: as recorded
+        return Manifest.read(record).experiments[name]
+    curved = [spec["name"] for spec in experiment.get("report", {}).get("figures", []) if spec["kind"] in CURVES]
+    if from_record and curved:
+        raise ConfigError(f"{name}: {from_record} of {len(runs)} runs are in the record only, which keeps no per-frame "
+                          f"series for its curve figure {curved[0]!r}; compute them to record it: "
+                          f"pf-replicate experiment={name} scale=paper skip_recorded=false")
     path = record / name / RUNS_FILE
     write_table(runs_table(rows), path)
     return Entry.of([path, *write_curves(experiment, store, runs, record / name / CURVES_DIR)], record, rows)
@@ -85,7 +108,8 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
         rows, missing = [], 0
         for name in multiverse.experiments:
             series = kept_series(multiverse.experiment_configs[universe.name, name])
-            found, absent = stored_rows(multiverse.runs[universe.name, name], Store(store_root, name), series)
+            runs = multiverse.runs[universe.name, name]
+            found, absent, _ = stored_rows(runs, Store(store_root, name), series, recorded_rows(record, runs))
             rows, missing = rows + [{**picks, **r} for r in found], missing + absent
         if missing:
             kept_as = "kept as recorded" if path.exists() else "not recorded"

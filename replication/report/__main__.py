@@ -1,5 +1,6 @@
-"""``python -m replication.report [scale=quick] [experiment=a,b] [pdf=false] [screenshot=true] [source=record]``:
-rebuild reports from stored runs only.
+"""``python -m replication.report [scale=quick|paper] [experiment=a,b] [pdf=false] [screenshot=true] [source=record]``:
+rebuild reports from stored runs only (at the default scale, quick, unless ``scale=`` says otherwise; at the
+paper scale, with the record's runs beneath the store's as a run reads them: :mod:`replication.record.layer`).
 
 ``source=record`` draws the paper-scale record's reports instead (:mod:`replication.record`: every
 experiment it holds, at the paper scale, into ``<reports>/record/``): tables, verdicts and the figures
@@ -14,6 +15,7 @@ store, ``reports/index.html`` links them under the summary of every published
 cell, and ``reports/replication.pdf`` gathers the same tables and figures
 (``pdf=false`` skips it).  ``screenshot=true`` also saves headless Chromium's
 view of the index as ``reports/screenshot.png`` (where Chromium is installed).
+A bar counts the experiments drawn (``progress=false`` hides it).
 """
 
 import shutil
@@ -22,12 +24,15 @@ from pathlib import Path
 
 from hydra import compose, initialize_config_dir
 from joblib import Parallel, delayed
+from tqdm.auto import tqdm
 
+from replication import atomic
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
+from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
@@ -40,6 +45,7 @@ from replication.runner.multiverse import load as load_multiverse
 from replication.runner.preflight import check_yaml
 from replication.runner.results import Results
 from replication.runner.store import Store
+from replication.scales import report_folder
 
 SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
 SCREENSHOT = "screenshot.png"
@@ -81,7 +87,10 @@ def main(argv: list[str]) -> None:
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # the settings: workers, folders
         cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
     try:  # each experiment's pages on its own worker (the order of the output is the experiments')
-        drawn = Parallel(n_jobs=cfg.n_jobs)(delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+        pages = Parallel(n_jobs=cfg.n_jobs, return_as="generator")(
+            delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+        drawn = list(tqdm(pages, total=len(names), desc="pages", unit="experiment", disable=not cfg.progress,
+                          mininterval=1.0))
     except ConfigError as error:
         fail(str(error))
     stale = {}  # drawn from the record: per experiment, its recorded runs that other code made
@@ -145,14 +154,17 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
             return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
                                    for u in multiverse.universes for e in multiverse.experiments), \
                 len(multiverse.universes)
-        if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs
-            multiverse = load_multiverse(cfg)
-            return name, write_multiverse_report(cfg, multiverse, tuple(overrides)), None, 0
+        if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs (at paper scale,
+            multiverse = load_multiverse(cfg)  # the record's beneath them, as the run read them)
+            return name, write_multiverse_report(cfg, multiverse, tuple(overrides),
+                                                 reader(*universes_beneath(cfg, multiverse))), None, 0
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
             return name, write_experiment_report(cfg, results), len(store.stale(results.runs)), 0
-        results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
+        runs = expand(cfg)
+        held = beneath(cfg, runs, Store(resolve(cfg.store), name))  # at paper scale, as the run read them
+        results = Results.of(cfg, runs, held, tuple(overrides), held.curves)
         return name, write_experiment_report(cfg, results), None, 0
 
 
@@ -171,12 +183,11 @@ def findings(argv: list[str]) -> None:
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
     drawn = Drawn(resolve(settings["reports"]) / PAGES)
     rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
-    drawn_from = drawn.status.get("drawn_from") if (drawn.folder / STATUS).exists() else None
-    if drawn_from != drawn_inputs(rendered_from):  # another record, configs or code
+    if drawn_pages(record, argv) is None:  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
         main(["source=record", "pdf=false", "screenshot=true", *argv])
         if (drawn.folder / SCREENSHOT).exists():  # the scorecard's picture, where Chromium is installed
-            shutil.copyfile(drawn.folder / SCREENSHOT, out / PICTURE)
+            atomic.save(out / PICTURE, lambda tmp: shutil.copyfile(drawn.folder / SCREENSHOT, tmp))
             print(f"findings: {out / PICTURE}")
     try:
         pages = render_findings(drawn, out / "templates")
@@ -185,6 +196,17 @@ def findings(argv: list[str]) -> None:
         fail(str(error))
     for page in written:
         print(f"findings: {page}")
+
+
+def drawn_pages(record: Path, overrides: list[str]) -> Path | None:
+    """``<reports>/record`` where it holds ``record``'s pages drawn by this code from these configs and published
+    values (``report source=record`` wrote them); None where it does not."""
+    settings = _settings(overrides)
+    folder = resolve(settings["reports"]) / PAGES
+    rendered_from = inputs(record, resolve(settings["findings"]) / "templates",
+                           published_path(settings["published_values"]))
+    drawn_from = Drawn(folder).status.get("drawn_from") if (folder / STATUS).exists() else None
+    return folder if drawn_from == drawn_inputs(rendered_from) else None
 
 
 def recorded_experiments(names: list[str], overrides: list[str], chosen: bool) -> tuple[list[str], list[str]]:
@@ -234,7 +256,8 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
                                + ([f"metric={metric}"] if metric else []))
             results = Results.of(cfg, expand(cfg), Store(resolve(cfg.store), name), tuple(overrides))
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
-                                      resolve(cfg.reports) / results.name / "sweeps", missing, command)
+                                      report_folder(resolve(cfg.reports), results.name, cfg.scale) / "sweeps",
+                                      missing, command)
             write_experiment_report(cfg, results)  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])

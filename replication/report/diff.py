@@ -1,49 +1,81 @@
 """``pf-replicate diff A B``: every claim and published cell whose verdict or estimate differs between two
 sets of results, before and after.
 
-A and B are each a record folder (``record/``: its pages are drawn first, as ``report source=record``
-draws them), a drawn report folder (one holding ``claims.csv`` and ``summary.csv``: ``reports``,
-``reports/record``), or ``store``: the runs in the store at the paper scale.  One line per changed claim
-(verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict), then
-the totals.  :func:`verdicts` compares the verdicts alone, of some experiments of two records:
-``pf-replicate verify``'s judgement of the runs it re-computed.
+A and B are each a record folder (``record/``, or any folder holding its ``manifest.json``: its pages are
+drawn first, as ``report source=record`` draws them, unless ``reports/record`` holds them drawn from that
+very record by this code), a drawn report folder (one holding ``claims.csv`` and ``summary.csv``:
+``reports``, ``reports/record``), or ``store``: the runs in the store at the paper scale.  Each is named as it
+was given, with what is done with it (drawing a record's pages shows a bar of its experiments); the scratch
+folders pages are drawn into are never named, since they are gone when the command ends.  Then one line per
+changed claim (verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict),
+and the totals.  Exit status 0 when nothing differs, 1 when a claim or a cell does (as ``diff`` does), 2
+when A or B is none of the above.
+
+:func:`verdicts` compares the verdicts alone, of some experiments of two records: ``pf-replicate verify``'s
+judgement of the runs it re-computed.
 """
 
 import io
 import sys
 import tempfile
-from contextlib import ExitStack, redirect_stderr, redirect_stdout
+from contextlib import ExitStack, redirect_stdout
 from pathlib import Path
 
 import pandas as pd
 
 from replication.errors import fail
-from replication.record.manifest import MANIFEST, PAGES
+from replication.paths import resolve
+from replication.record.manifest import MANIFEST, PAGES, Manifest
 
 CLAIM = ("claim_id",)
 CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost")
 CELL = ("paper", "table", "experiment", "method", "metric", "condition")
 CELL_FIELDS = ("ours", "runs", "verdict", "reason")
 VERDICTS = {CLAIM: ("verdict", "robust", "at_equal_cost"), CELL: ("verdict",)}  # what must not move, by key
+NO_RECORD = ("a record is a folder holding manifest.json, such as the repository's record/ (a clone has it; an "
+             "installed copy ships none)")
 
 
-def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs: int | None = None) -> Path:
-    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it first if need be
-    (of a record, only its ``experiments`` where named, on ``n_jobs`` workers where given)."""
+def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs: int | None = None,
+          side: str = "") -> Path:
+    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it into ``scratch``
+    first if need be (of a record, only its ``experiments`` where named, on ``n_jobs`` workers where given).
+    The drawing shows a bar of the experiments drawn.  With ``side`` (A or B), say first what ``source`` is and
+    what is done with it; of a whole record, read ``reports/record`` where it holds that record's pages as this
+    code draws them."""
+    from replication.report.__main__ import drawn_pages
     from replication.report.__main__ import main as report
 
-    path = Path(source)
+    def say(what: str) -> None:
+        if side:
+            print(f"{side}: {source}: {what}", flush=True)
+
+    path = resolve(source) if source != "store" else Path(source)
+    # the scratch folder's pages, named nowhere; no findings (only the claims and cells are compared)
+    settings = [f"reports={scratch}", "pdf=false", f"findings={scratch / 'no-findings'}"]
     if (path / "claims.csv").exists() and (path / "summary.csv").exists():
+        say("a drawn report, read as it is")
         return path
     if (path / MANIFEST).exists():
+        ready = None if experiments else drawn_pages(path, [])
+        if ready is not None:
+            say(f"a record whose pages {ready} holds, drawn from it by this code: read as they are")
+            return ready
+        say(f"a record of {len(Manifest.read(path).experiments)} experiments and multiverses: drawing its pages")
         only = [f"experiment={','.join(experiments)}"] if experiments else []
         workers = [f"n_jobs={n_jobs}"] if n_jobs else []
-        report(["source=record", f"record={path.resolve()}", f"reports={scratch}", "pdf=false", *only, *workers])
+        with redirect_stdout(io.StringIO()):
+            report(["source=record", f"record={path}", *settings, *only, *workers])
         return scratch / PAGES
     if source == "store":
-        report(["scale=paper", f"reports={scratch}", "pdf=false"])
+        say("the store's runs at the paper scale: drawing their pages")
+        with redirect_stdout(io.StringIO()):
+            report(["scale=paper", *settings])
         return scratch
-    fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no claims.csv and summary.csv) nor 'store'")
+    if not path.exists():
+        fail(f"{source}: no such folder ({path}); {NO_RECORD}")
+    fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no claims.csv and summary.csv) nor 'store'; "
+         f"{NO_RECORD}")
 
 
 def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...],
@@ -74,7 +106,7 @@ def verdicts(before: Path, after: Path, experiments: list[str], n_jobs: int = 2)
     """Each claim and published cell whose verdict differs between two records judged on their entries
     ``experiments`` (each drawn as ``report source=record`` draws it), a line each; printed after the counts,
     with how many estimates moved though their verdict held."""
-    with ExitStack() as stack, redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()):  # scratch pages
+    with ExitStack() as stack:
         folders = [drawn(str(source), Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="verdicts-"))),
                          tuple(experiments), n_jobs) for source in (before, after)]
         tables = {key: [pd.read_csv(folder / name, dtype=str) for folder in folders]
@@ -95,17 +127,18 @@ def main(argv: list[str]) -> None:
             sys.exit(2)
         return
     with ExitStack() as stack:
-        folders = [drawn(source, Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="diff-"))))
-                   for source in argv]
+        folders = [drawn(source, Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="diff-"))), side=side)
+                   for side, source in zip("AB", argv)]
         claims = [pd.read_csv(folder / "claims.csv", dtype=str) for folder in folders]
         cells = [pd.read_csv(folder / "summary.csv", dtype=str) for folder in folders]
     claim_changes = changes(*claims, CLAIM, CLAIM_FIELDS)
     claim_lines = [line(*change) for change in claim_changes]
     cell_lines = [line(*change) for change in changes(*cells, CELL, CELL_FIELDS)]
-    print(f"A: {argv[0]}\nB: {argv[1]}")
     for title, lines in (("claims", claim_lines), ("published cells", cell_lines)):
         print(f"\n{title}: {len(lines)} changed")
         print(*lines, sep="\n", end="\n" if lines else "")
     verdicts = sum("verdict" in moved for _, moved in claim_changes)
     print(f"\n{len(claims[1])} claims: {verdicts} changed verdict, {len(claim_lines)} changed at all; "
           f"{len(cells[1])} cells: {len(cell_lines)} changed")
+    if claim_lines or cell_lines:
+        sys.exit(1)

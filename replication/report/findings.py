@@ -40,6 +40,7 @@ from pathlib import Path
 import jinja2
 import pandas as pd
 
+from replication import atomic
 from replication.evidence.claims import Paper, load_papers
 from replication.evidence.statistics import said_level
 from replication.evidence.summary import load_summaries
@@ -322,9 +323,10 @@ def write_pages(pages: dict[str, str], out: Path, rendered_from: dict[str, str],
             written.append(embed(readme, text))
         else:
             written.append(out / f"{name}.md")
-            written[-1].write_text(text)
+            atomic.write_text(written[-1], text)
     digests = {name: _digest(text) for name, text in pages.items()}
-    (out / RENDERED).write_text(json.dumps({"inputs": rendered_from, "pages": digests}, indent=1) + "\n")
+    rendered = {"inputs": rendered_from, "pages": digests}
+    atomic.write_text(out / RENDERED, json.dumps(rendered, indent=1) + "\n")
     return written
 
 
@@ -352,7 +354,7 @@ def embed(readme: Path, text: str) -> Path:
     parts = _parts(readme)
     if parts is None:
         raise LookupError(f"{readme} has no part for the record: put {' and '.join(README_MARKS)} in it")
-    readme.write_text(parts[0] + text + parts[2])
+    atomic.write_text(readme, parts[0] + text + parts[2])
     return readme
 
 
@@ -399,7 +401,7 @@ def write_html(pages: dict[str, str], out: Path) -> list[Path]:
         body = re.sub(r'href="([\w-]+)\.md"', r'href="\1.html"', markdown.render(text))
         title = next((line[2:] for line in text.splitlines() if line.startswith("# ")), name)
         path = out / f"{name}.html"
-        path.write_text(render_page("findings.html.j2", title=title, body=Markup(body)))
+        atomic.write_text(path, render_page("findings.html.j2", title=title, body=Markup(body)))
         written.append(path)
     return written
 

@@ -27,19 +27,21 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 import replication  # noqa: E402
+from replication import atomic  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
 from replication.report.pages import glance  # noqa: E402
 from replication.report.pages.index import TITLE  # noqa: E402
 from replication.evidence.published import load_published, published_path  # noqa: E402
-from replication.evidence.claims import load_papers  # noqa: E402
+from replication.evidence.claims import Paper, load_papers  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.evidence.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
 from replication.evidence.schema import Summary  # noqa: E402
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
 from replication.evidence.tables import Table  # noqa: E402
 from replication.evidence.settings import rules  # noqa: E402
+from replication.scales import report_folder  # noqa: E402
 
 PAGE = (11.69, 8.27)  # A4 landscape, inches
 FONT = 7.0  # table text, points: the smallest that reads in print (a long cell wraps rather than shrinks)
@@ -68,6 +70,14 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     quick = [name for name, s in summaries.items() if s.scale != "paper"]
     banner = (f"Quick scale ({len(quick)} of {len(summaries)} experiments): fewer runs and shorter scenes than "
               f"the papers'. Paper scale: {PAPER_COMMAND}." if quick else None)
+    with atomic.replacing(path) as tmp:  # the book and its outline whole, then in place of the last one
+        _write_book(tmp, reports, summaries, cells, rows, papers, banner)
+    return path
+
+
+def _write_book(path: Path, reports: Path, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict,
+                papers: list[Paper], banner: str | None) -> None:
+    """Every page of the book as ``path``, then its outline."""
     tallies = cell_tallies(cells)
     with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path, banner) as pdf:
         _title_page(pdf, summaries, cells, rows, glance.write(reports, papers, rows))
@@ -83,18 +93,18 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
                      "matched it, otherwise why not")
         for name, summary in summaries.items():
             heading = summary.title
-            for table in [t for t in summary.tables if (reports / name / t["csv"]).exists()]:
-                frame = _shown(pd.read_csv(reports / name / table["csv"]))
+            folder = report_folder(reports, name, summary.scale)
+            for table in [t for t in summary.tables if (folder / t["csv"]).exists()]:
+                frame = _shown(pd.read_csv(folder / table["csv"]))
                 subtitle = " ".join(filter(None, [table["title"], table.get("note")]))
                 _table_pages(pdf, heading, frame, subtitle=subtitle, font=TABLE_FONT)
-            for figure in [f for f in summary.figures if (reports / name / f["file"]).exists()]:
-                _figure_page(pdf, heading, figure["title"], reports / name / figure["file"])
+            for figure in [f for f in summary.figures if (folder / f["file"]).exists()]:
+                _figure_page(pdf, heading, figure["title"], folder / figure["file"])
         info = pdf.infodict()
         info["Title"] = TITLE
         info["Subject"] = "The papers' published values against ours, with 95% intervals"
         info["Creator"] = f"replication {replication.__version__}"
     _outline(path, pdf.marks)
-    return path
 
 
 def _shown(frame: pd.DataFrame) -> pd.DataFrame:

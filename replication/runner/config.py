@@ -21,11 +21,13 @@ from collections.abc import Iterator
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
+from tqdm.auto import tqdm
 
 from replication.condition import Condition
 from replication.errors import ConfigError
 from replication.filters.registry import build_filter, builder
 from replication.run import Run
+from replication.runner.bounds import MANY_RUNS, check_runs
 from replication.runner.provenance import method_code_digest
 from replication.scales import SCALES, at_scale
 from replication.runner.sequences import locate_sequences
@@ -85,13 +87,23 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
     """All runs of ``cfg.experiment`` at ``cfg.scale``, validated.
 
     Conditions whose data are absent (a real sequence not on this machine) are
-    left out, with a message appended to ``skipped``.
+    left out, with a message appended to ``skipped``.  The runs are counted before any is built, and a
+    count that cannot fit in memory is refused (:func:`~replication.runner.bounds.check_runs`); a count of
+    :data:`~replication.runner.bounds.MANY_RUNS` or more shows its progress while it is listed.
     """
     exp = cfg.experiment
     repetitions = n_runs(cfg)
     task = TASKS[exp.get("task")]
+    name, kind, seed = exp.name, exp.task, int(cfg.base_seed)  # read once: each lookup costs more than a run
     experiment = experiment_at_scale(cfg)
     scenes = experiment.get("scenes", {})
+    # counted in a pass of their own: the runs' blocks are built as they are listed, after the conditions
+    # before them (a check may fill in a block some share), exactly as their keys were always computed
+    conditions = sum(1 for _ in planned(experiment))
+    check_runs(f"experiment.runs.{cfg.scale} = {repetitions:,} per condition x {conditions:,} conditions",
+               repetitions * conditions)
+    listed = tqdm(total=repetitions * conditions, desc=f"{name}: listing its runs", unit="run",
+                  disable=not cfg.get("progress") or repetitions * conditions < MANY_RUNS, mininterval=1.0)
     runs, skipped = [], [] if skipped is None else skipped
     codes: dict[str, str] = {}  # filter name -> the digest of the code its runs execute
     for method, condition, data_condition, run_model, run_params in planned(experiment):
@@ -113,12 +125,13 @@ def expand(cfg: DictConfig, skipped: list[str] | None = None) -> list[Run]:
         build_filter(method, run_params, str(condition))
         if run_params["filter"] not in codes:  # a filter's code is digested once, not once per swept value
             codes[run_params["filter"]] = method_code_digest(task, builder(run_params["filter"]))
-        key = _run_key(exp.task, run_model, run_params, int(cfg.base_seed), codes[run_params["filter"]])
+        key = _run_key(kind, run_model, run_params, seed, codes[run_params["filter"]])
         runs.extend(
-            Run(exp.name, exp.task, method, condition, r, run_model, run_params, int(cfg.base_seed), key,
-                data_condition)
+            Run(name, kind, method, condition, r, run_model, run_params, seed, key, data_condition)
             for r in range(repetitions)
         )
+        listed.update(repetitions)
+    listed.close()
     return runs
 
 

@@ -14,7 +14,9 @@ scipy and numba) installed; tracking runs also need the scene data at the
 same relative path.
 """
 
+import asyncio
 import importlib.util
+import ipaddress
 import logging
 import os
 import signal
@@ -24,15 +26,17 @@ import threading
 import time
 import warnings
 from collections.abc import Iterator
-from contextlib import closing, contextmanager
+from contextlib import closing, contextmanager, nullcontext
 
 import numpy as np
-from joblib import Parallel, delayed, effective_n_jobs, parallel_config
+from joblib import Parallel, delayed, effective_n_jobs, parallel_config, register_parallel_backend
 from tqdm.auto import tqdm
 
 import replication
+from replication.condition import Condition
 from replication.errors import RunFailed
 from replication.run import Run
+from replication.runner.bounds import MANY_RUNS
 from replication.runner.failures import failure
 from replication.runner.lifeline import start_worker
 from replication.runner.memory import one_thread, retain_freed_memory
@@ -48,6 +52,7 @@ CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each clus
 # sent back, and stored, a batch of RUNS_PER_WORKER runs per worker at a time
 LIST_ONLY_BACKENDS = ("ray",)
 RUNS_PER_WORKER = 2
+STOP_S = 1.0  # an interrupted local dask worker is killed after this long, its run unfinished
 
 
 class BackendError(RuntimeError):
@@ -118,30 +123,8 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
         with _dask_client(address, n_jobs), parallel_config(backend="dask"):
             yield
     elif backend == "ray":
-        import ray
-        from ray.util.joblib import register_ray
-
-        register_ray()
-        started = not ray.is_initialized()
-        if started:
-            if address:  # ray.init retries an address that does not answer for minutes, printing every 5 s
-                try:
-                    _answers(address)
-                except OSError as error:
-                    raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
-            try:
-                # no address: a new local cluster, never one named by RAY_ADDRESS or by a file a past one left
-                ray.init(address=address or "local", log_to_driver=False)
-            except (ConnectionError, RuntimeError, ValueError) as error:
-                where = f"ray at parallel.address={address}" if address else "ray on this machine"
-                hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
-                raise BackendError(f"cannot start or reach {where}: {_one_line(error)}{hint}") from None
-        try:
-            with parallel_config(backend="ray", n_jobs=-1 if address else n_jobs):
-                yield
-        finally:
-            if started:
-                ray.shutdown()
+        with _ray_cluster(address), parallel_config(backend="ray", n_jobs=-1 if address else n_jobs):
+            yield
     elif backend == "loky":
         with parallel_config(backend="loky", n_jobs=n_jobs, initializer=start_worker, initargs=(os.getpid(),)):
             yield
@@ -156,6 +139,94 @@ def _answers(address: str, seconds: float = 10.0) -> None:
     host, _, port = address.removeprefix("ray://").rpartition(":")
     if host and port.isdigit():
         socket.create_connection((host, int(port)), timeout=seconds).close()
+
+
+@contextmanager
+def _ray_cluster(address: str | None) -> Iterator[None]:
+    """ray connected for the duration, and shut down after if it was started here: the cluster at ``address``
+    (first checked to answer), or, with no address, a new local cluster on the loopback alone
+    (:func:`_ray_on_the_loopback`), never one named by ``RAY_ADDRESS`` or by a file a past one left."""
+    import ray
+
+    _register_ray()
+    if ray.is_initialized():  # a session of the caller's own: used as it is, and left running
+        yield
+        return
+    if address:  # ray.init retries an address that does not answer for minutes, printing every 5 s
+        try:
+            _answers(address)
+        except OSError as error:
+            raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
+    with nullcontext() if address else _ray_on_the_loopback():
+        try:
+            with _sigterm_kept(), warnings.catch_warnings():
+                warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
+                ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
+                         **({} if address else {"include_dashboard": False}))  # the runner never reads it
+        except (ConnectionError, RuntimeError, ValueError) as error:
+            where = f"ray at parallel.address={address}" if address else "ray on this machine"
+            hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
+            raise BackendError(f"cannot start or reach {where}: {_one_line(error)}{hint}") from None
+        try:
+            node = ray.util.get_node_ip_address()
+            if not (address or ipaddress.ip_address(node).is_loopback):
+                raise BackendError(f"a local ray cluster started on {node}, not on the loopback (127.0.0.1): this "
+                                   f"ray release ignores {RAY_LOCAL_ONLY}=0; use parallel.backend=dask")
+            yield
+        finally:
+            ray.shutdown()
+
+
+def _register_ray() -> None:
+    """ray's joblib backend as ``ray``, aborting (an interrupt, a run's error) without a new pool: joblib leaves
+    the pool of a ``with Parallel()`` block ready for more work, which for ray's actors takes 10 s and more on
+    a loaded machine, after a SIGTERM too; the runner submits nothing to a pool after an abort."""
+    from ray.util.joblib.ray_backend import RayBackend
+
+    class Stopping(RayBackend):
+        def abort_everything(self, ensure_ready: bool = True) -> None:
+            super().abort_everything(ensure_ready=False)
+
+    register_parallel_backend("ray", Stopping)
+
+
+RAY_LOCAL_ONLY = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # "0": ray without clusters, its node on the loopback
+
+
+@contextmanager
+def _ray_on_the_loopback() -> Iterator[None]:
+    """While it lasts, a local ray cluster takes the loopback (127.0.0.1) for its node's address, and every
+    service it starts (GCS, raylet, object manager, workers, agents) listens there alone, as a local dask
+    cluster does.  On Linux ray takes the machine's own address instead and listens on every interface; it
+    takes the loopback where clusters of several machines are not enabled (:data:`RAY_LOCAL_ONLY` ``=0``,
+    macOS's and Windows's default).  The processes ray starts read that variable from their environment;
+    this process read it once, when ray was imported, into the constant set here too."""
+    from ray._private import ray_constants
+
+    saved = os.environ.get(RAY_LOCAL_ONLY), ray_constants.ENABLE_RAY_CLUSTER
+    os.environ[RAY_LOCAL_ONLY], ray_constants.ENABLE_RAY_CLUSTER = "0", False
+    try:
+        yield
+    finally:
+        ray_constants.ENABLE_RAY_CLUSTER = saved[1]
+        if saved[0] is None:
+            os.environ.pop(RAY_LOCAL_ONLY, None)
+        else:
+            os.environ[RAY_LOCAL_ONLY] = saved[0]
+
+
+@contextmanager
+def _sigterm_kept() -> Iterator[None]:
+    """This process's SIGTERM handler put back after the block.  ``ray.init`` installs its own, twice: one
+    that exits at once, and its core worker's, which aborts: either would leave ray's processes and the
+    workers' runs behind, where the runner's (:func:`~replication.runner.lifeline.stop_on_sigterm`) stops
+    them and keeps every run stored."""
+    previous = signal.getsignal(signal.SIGTERM)
+    try:
+        yield
+    finally:
+        if previous is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager
@@ -197,10 +268,20 @@ def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
         raise BackendError(f"cannot reach {where}: {_one_line(error)}") from None
     try:
         yield
+    except BaseException:  # interrupted: stop the local workers now, not once their runs end (a nanny waits 4 s)
+        if cluster is not None:
+            cluster.sync(_stop_now, cluster)
+        raise
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+async def _stop_now(cluster) -> None:
+    """Close a local dask cluster's workers at once: each nanny kills its worker's process after
+    :data:`STOP_S`, mid-run (a process slow to be reaped is left to the cluster's own close)."""
+    await asyncio.gather(*(nanny.close(timeout=STOP_S) for nanny in cluster.workers.values()), return_exceptions=True)
 
 
 def _records(pending: list[Run], streamed: bool) -> Iterator[dict]:
@@ -236,10 +317,10 @@ def forecast(runs: list[Run], pending: list[Run], store: Store, n_jobs: int, sam
     experiment; their mean over all stored runs where a condition has none) over the workers."""
     said = f"{runs[0].experiment}: {len(runs):,} runs, {len(pending):,} to compute"
     waiting = {run.run_id for run in pending}
-    seen: dict[tuple[str, str], list[float]] = {}
+    seen: dict[tuple[str, Condition], list[float]] = {}
     for run in runs:
-        times = seen.setdefault((run.method, str(run.condition)), [])
-        if run.run_id not in waiting and len(times) < sample:
+        times = seen.setdefault((run.method, run.condition), [])
+        if len(times) < sample and run.run_id not in waiting:
             record = store.read(run)
             if record is not None:
                 times.append(float(record["wall_s"]))
@@ -247,7 +328,8 @@ def forecast(runs: list[Run], pending: list[Run], store: Store, n_jobs: int, sam
     if not known:
         return f"{said} (no stored run of it to time them by)"
     workers = min(effective_n_jobs(n_jobs) if n_jobs else 1, len(pending))
-    seconds = sum(np.mean(seen[run.method, str(run.condition)] or known) for run in pending) / max(workers, 1)
+    each = {condition: np.mean(times or known) for condition, times in seen.items()}  # once, not once a run
+    seconds = sum(each[run.method, run.condition] for run in pending) / max(workers, 1)
     return f"{said}, about {duration(seconds)} on {workers} worker(s) (from {len(known)} stored runs' times)"
 
 
@@ -286,7 +368,11 @@ def execute(
     A KeyboardInterrupt stops the workers and propagates, with every record
     that arrived before it stored.
     """
-    pending, corrupt = store.pending(runs)
+    if not runs:  # every run read from the record, say
+        return 0
+    checked = tqdm(runs, desc=f"{runs[0].experiment}: checking the store", unit="run", mininterval=1.0,
+                   disable=not progress or len(runs) < MANY_RUNS)
+    pending, corrupt = store.pending(checked)
     pending = schedule(pending)
     if corrupt:
         print(f"re-running {len(corrupt)} corrupt result file(s): {summarise(corrupt)}", file=sys.stderr)

@@ -18,7 +18,6 @@ from collections.abc import Iterator
 import numpy as np
 
 from replication.run import Run
-from replication.runner.store import Store
 
 UNDEFINED = {  # metric: when it is undefined, and so stored as NaN (or inf) without failing the run
     "mean_ess": "a filter without particles (the point-mass grid) has no effective sample size",
@@ -78,8 +77,9 @@ def _numeric(items: list | tuple) -> np.ndarray | None:
     return array.reshape(-1) if array.dtype.kind in "fiub" else None
 
 
-def exit_if_failed(store: Store, runs: list[Run]) -> None:
-    """One line on stderr per reason with the number of ``runs`` that failed for it, then exit with
+def exit_if_failed(store, runs: list[Run]) -> None:
+    """One line on stderr per reason with the number of ``runs`` that failed for it in ``store`` (a
+    :class:`~replication.runner.store.Store`, which imports this module to check records), then exit with
     :data:`FAILED_STATUS`; nothing if none failed."""
     failures = store.failures(runs)
     for reason, count in failures.most_common():

@@ -10,11 +10,13 @@ dask backend's local workers die with their parent already (distributed watches 
 processes are ray's to manage.
 """
 
+import gc
 import os
 import signal
 import threading
 import time
 from functools import cache
+from pathlib import Path
 
 PARENT_VARIABLE = "REPLICATION_PARENT_PID"  # set by a runner for the companion it starts
 POLL_S = 0.5
@@ -69,6 +71,28 @@ def _interrupt(signum: int, frame) -> None:
     _signal_received = signum
     signal.signal(signum, signal.SIG_DFL)
     raise KeyboardInterrupt
+
+
+def stop_children() -> None:
+    """SIGTERM to every child of this process still running: one the runner's clean-up left behind, such as a
+    loky worker caught starting (its interpreter not yet up to read its task, nor holding its lifeline), which
+    Python's exit would otherwise wait for, seconds each.  A worker dies of it; a companion runner stops as
+    after Ctrl-C; a resource tracker ignores it and ends when its last user has.  Linux (``/proc``) only."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            state, parent = stat.read_text().rsplit(")", 1)[1].split()[:2]
+            if int(parent) == os.getpid() and state != "Z":
+                os.kill(int(stat.parent.name), signal.SIGTERM)
+        except (OSError, ValueError):  # gone meanwhile, or not ours to signal
+            continue
+
+
+def exit_uncollected() -> None:
+    """Let this process exit without Python's last garbage collection, which walks every object on the heap
+    (numba's compiled kernels and their LLVM modules among them: 3-4 s of a runner's exit on a loaded
+    machine, after a SIGTERM as after a finished run) only to free memory the process is handing back whole.
+    Objects are still finalized as their modules are cleared."""
+    gc.freeze()
 
 
 def interrupt_status() -> int:

@@ -8,9 +8,10 @@ decodable) is :mod:`replication.runner.validate`'s, after the imports but still 
 Numbers are checked by what their key names: every number is finite; a ``sigma`` or a variance is
 positive, a standard deviation (``*_sd``, ``P0``) is not negative; counts (``n_*``, ``steps``, ...)
 are positive integers; and a key that names one of these holds a number, not a word (``Q=abc``).
-Names that become file names (the experiment's, its methods' and scenes') are restricted to
-:data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
-directory unless ``outside_project=true``.
+Names that become file names (the experiment's, its methods' and scenes', the sequences of
+``sequences=``) are restricted to :data:`SAFE_NAME`; ``store`` and ``reports`` must lie inside the project
+directory unless ``outside_project=true``.  What a request asks of this machine (local workers, particles
+in memory) is bounded by :mod:`replication.runner.bounds`.
 """
 
 import math
@@ -24,7 +25,8 @@ from omegaconf import DictConfig, ListConfig, OmegaConf
 
 from replication.errors import ConfigError
 from replication.paths import inside_project, project_dir, resolve
-from replication.scales import SCALES
+from replication.runner.bounds import check_particles, check_workers
+from replication.scales import SCALES, at_scale
 
 SAFE_NAME = re.compile(r"(?![.\s])[^/\\\x00-\x1f]+")  # one file name: no separator, no leading dot
 POSITIVE = re.compile(r"(sigma\w*|\w+_sigma|\w*_var|variance|Q|R)")  # a scale: zero or less is meaningless
@@ -62,9 +64,13 @@ def check_settings(cfg: DictConfig) -> None:
         raise ConfigError(f"n_jobs must be a positive number of workers or -1 for all cores, got {n_jobs!r}")
     if cfg.get("scale") not in SCALES:
         raise ConfigError(f"scale must be one of {', '.join(SCALES)}, got {cfg.get('scale')!r}")
-    for flag in ("outside_project", "skip_recorded"):
+    for flag in ("outside_project", "skip_recorded", "dry_run", "n_jobs_beyond_cores"):
         if not isinstance(cfg.get(flag), bool):
             raise ConfigError(f"{flag} must be true or false, got {cfg.get(flag)!r}")
+    record = cfg.get("record")
+    if not isinstance(record, str) or not record:
+        raise ConfigError(f"record must be a folder (a clone's record/), got {record!r}")
+    check_sequences(cfg.get("sequences"))
     claims = cfg.get("claims_dir")
     if claims is not None and (not isinstance(claims, str) or not resolve(claims).is_dir()):
         raise ConfigError(f"claims_dir must be a folder of your claims files (*.yaml), got {claims!r}")
@@ -78,6 +84,15 @@ def check_settings(cfg: DictConfig) -> None:
                 f"add outside_project=true to write there"
             )
         check_writable(key, resolve(value))
+
+
+def check_sequences(sequences: Any) -> None:
+    """Each name of ``sequences=[...]`` is a sequence's folder name in ``data.otb`` / ``data.mot``, never a path
+    (``../otb/Girl``, ``/data/Girl``): where sequences are read from is ``data.*``'s to say."""
+    for name in sequences if isinstance(sequences, ListConfig) else ():
+        if isinstance(name, str) and not SAFE_NAME.fullmatch(name):
+            raise ConfigError(f"sequences: {name!r} is a path, not a sequence's name (no / or \\, no leading dot); "
+                              "say where sequences are with data.otb= (data.mot=) and name them by folder")
 
 
 def check_writable(key: str, folder: Path) -> None:
@@ -169,12 +184,25 @@ def check_numbers(value: Any, where: str, key: str = "") -> None:
         raise ConfigError(f"{where} must be a positive integer, got {value!r}")
 
 
+def check_machine(cfg: DictConfig) -> None:
+    """What a request computed here asks of this machine (:mod:`replication.runner.bounds`): its local workers
+    within the cores, and its largest particle count in memory in each of them.  A cluster's address
+    (``parallel.address``) sends the runs elsewhere: nothing to bound here."""
+    parallel = cfg.get("parallel")
+    if isinstance(parallel, DictConfig) and parallel.get("address"):
+        return
+    check_workers(cfg.n_jobs, cfg.n_jobs_beyond_cores)
+    if "multiverse" not in cfg.experiment:  # a multiverse's universes are shipped experiments' variants
+        check_particles(at_scale(OmegaConf.to_container(cfg.experiment, resolve=True), cfg.scale), cfg.n_jobs)
+
+
 def preflight(cfg: DictConfig, written: dict | None = None) -> None:
     """Every check of this module, in the order a user would fix them; ``written``: the experiment's file
     as written (:func:`check_yaml`), whose run counts overrides are measured against."""
     runs = (written or {}).get("runs")
     check_experiment(cfg, runs.get("paper") if isinstance(runs, dict) else None)
     check_settings(cfg)
+    check_machine(cfg)
 
 
 def _integer(value: Any) -> bool:

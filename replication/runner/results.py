@@ -22,7 +22,7 @@ errors; :func:`replication.tasks.mot.frame_table`: a row per track, its box).  J
 
 A report is drawn from one :class:`Results` (:meth:`Results.of`: the experiment's config at its scale,
 its runs, their stored records and the failures' reasons), which also writes both tables
-(:meth:`Results.write_tables`) as ``reports/<experiment>/runs.parquet`` with ``runs.csv``, and
+(:meth:`Results.write_tables`) as ``runs.parquet`` with ``runs.csv`` in the experiment's report folder, and
 ``frames.parquet`` (no CSV: up to a million rows at paper scale).
 """
 
@@ -35,6 +35,7 @@ import pandas as pd
 from hydra import compose, initialize_config_dir
 from omegaconf import DictConfig, OmegaConf
 
+from replication import atomic
 from replication.errors import ConfigError
 from replication.paths import CONF_DIR, resolve
 from replication.run import Run
@@ -62,6 +63,7 @@ class Results:
     changes: tuple[str, ...] = ()  # what the request changed in the shipped experiment (runner.variant)
     command: str = ""  # the command line that made these results
     curves: dict[str, pd.DataFrame] = field(default_factory=dict)  # figure -> its curve table, where kept (record)
+    at_paper_scale: dict = field(default_factory=dict)  # ``experiment`` at the paper's scale: what a scale changes
 
     @classmethod
     def of(cls, cfg: DictConfig, runs: list[Run], store: Store, overrides: tuple[str, ...] = (),
@@ -71,8 +73,10 @@ class Results:
         changes = differences(cfg)
         command = " ".join(["python -m replication", f"experiment={cfg.experiment.name}", f"scale={cfg.scale}",
                             *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])
-        return cls(experiment_at_scale(cfg), runs, store.load(runs), store.failures(runs),
-                   report_name(cfg, changes), tuple(changes), command, curves or {})
+        experiment = experiment_at_scale(cfg)
+        return cls(experiment, runs, store.load(runs), store.failures(runs), report_name(cfg, changes),
+                   tuple(changes), command, curves or {}, experiment_at_scale(cfg, "paper") if cfg.scale != "paper"
+                   else experiment)
 
     @property
     def own(self) -> bool:
@@ -137,13 +141,14 @@ def write(table: pd.DataFrame, path: Path, csv: bool = True) -> None:
     """
     nested = [c for c in table if table[c].dtype == object and table[c].map(_nested).any()]
     table = table.assign(**{c: table[c].map(lambda v: json.dumps(v) if _nested(v) else v) for c in nested})
-    table.to_parquet(path.with_suffix(".parquet"), index=False)
+    atomic.save(path.with_suffix(".parquet"), lambda tmp: table.to_parquet(tmp, index=False))
     if csv:
-        table.to_csv(path.with_suffix(".csv"), index=False)
+        atomic.save(path.with_suffix(".csv"), lambda tmp: table.to_csv(tmp, index=False))
 
 
-def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
-    """Every stored run of ``experiment`` at ``scale``, one row each, with its parameters and metrics.
+def load_runs(experiment: str, scale: str | None = None, *overrides: str) -> pd.DataFrame:
+    """Every stored run of ``experiment`` at ``scale`` (None: ``conf/config.yaml``'s, quick), one row each, with
+    its parameters and metrics.
 
     ``overrides`` are the command line's (``"store=/path"``, ``"experiment.runs.quick=3"``); runs not
     yet stored are absent (run the experiment first), and so are runs that failed
@@ -152,17 +157,18 @@ def load_runs(experiment: str, scale: str = "paper", *overrides: str) -> pd.Data
     return tidy(*stored_records(experiment, scale, *overrides))
 
 
-def load_frames(experiment: str, scale: str = "paper", *overrides: str) -> pd.DataFrame:
+def load_frames(experiment: str, scale: str | None = None, *overrides: str) -> pd.DataFrame:
     """Every frame of every stored run of ``experiment`` at ``scale`` (:func:`frames`); arguments as
     :func:`load_runs`."""
     return frames(*stored_records(experiment, scale, *overrides))
 
 
-def stored_records(experiment: str, scale: str = "paper", *overrides: str) -> tuple[pd.DataFrame, list[Run]]:
+def stored_records(experiment: str, scale: str | None = None, *overrides: str) -> tuple[pd.DataFrame, list[Run]]:
     """The stored records of an experiment's runs, and the runs (a multiverse has none of its own: its
     experiments' runs are theirs, and it says so)."""
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[f"experiment={experiment}", f"scale={scale}", *overrides])
+        cfg = compose("config", overrides=[f"experiment={experiment}", *([f"scale={scale}"] if scale else []),
+                                           *overrides])
     if "multiverse" in cfg.experiment:
         named = named_experiments(OmegaConf.to_container(cfg.experiment.multiverse, resolve=True))
         raise ConfigError(f"{experiment} is a multiverse: its runs are stored under its experiments', "

@@ -3,14 +3,15 @@
 Each raises :class:`ConfigError` with one line naming the bad key: a value of
 the wrong type for the filter it goes to, a look no figure can draw, an unknown
 ``parallel.*`` key or backend, a scene of an unknown kind or a real one whose folder
-does not exist, a condition a table, a figure or a claim names that no run of the
-experiment has.  :func:`prepare`
+does not exist or whose frames and ground truth do not pair up (the missing frames named), a condition a
+table, a figure or a claim names that no run of the experiment has.  :func:`prepare`
 runs them all and expands the experiment into its runs.
 """
 
 import inspect
 import types
 import typing
+from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
@@ -142,6 +143,52 @@ def check_scenes(cfg: DictConfig) -> None:
                 )
 
 
+def check_frames(cfg: DictConfig) -> None:
+    """Each OTB sequence the request reads has a frame for each ground-truth box, else one line naming the
+    frames missing (:func:`unpaired`).  The sequence's reader checks the counts too (its line names none):
+    this check, outside the code that computes runs, names them before it is reached.  A sequence that is
+    absent, or whose ground truth does not read, is left to the reader, which skips or names it."""
+    from replication.scenes.otb import GROUNDTRUTH_FILES, read_groundtruth
+
+    for spec in (experiment_at_scale(cfg).get("scenes") or {}).values():
+        if spec.get("kind") != "otb" or not isinstance(spec.get("name"), str):
+            continue
+        folder, name = GROUNDTRUTH_FILES.get(spec["name"], (spec["name"], "groundtruth_rect.txt"))
+        directory = resolve(str(spec["root"])) / folder
+        try:
+            boxes = len(read_groundtruth(directory / name))
+        except (OSError, ValueError):
+            continue
+        frames = sorted((directory / "img").glob("*.jpg"))
+        if frames and len(frames) != boxes:
+            raise ConfigError(unpaired(directory, frames, boxes))
+
+
+def unpaired(directory: Path, frames: list[Path], boxes: int) -> str:
+    """The line for frames and ground-truth boxes that do not pair up, naming the frames beyond the last box, or
+    those missing: the gaps in the frames' numbering, then those past its end where it starts at 1 (as OTB's
+    does; one that starts later may lack frames at either end)."""
+    said = f"{directory}: {len(frames)} frames but {boxes} ground-truth boxes"
+    if len(frames) > boxes:
+        return f"{said}: {listed([f'img/{p.name}' for p in frames[boxes:]])} beyond the last box"
+    numbers = sorted(int(p.stem) for p in frames if p.stem.isdigit())
+    if not numbers:
+        return said
+    missing = sorted(set(range(numbers[0], numbers[-1] + 1)) - set(numbers))
+    ends = boxes - len(frames) - len(missing)  # missing at the ends of the numbering
+    if ends > 0 and numbers[0] == 1:
+        missing, ends = missing + list(range(numbers[-1] + 1, numbers[-1] + 1 + ends)), 0
+    width, suffix = len(frames[0].stem), frames[0].suffix
+    names = [f"img/{n:0{width}d}{suffix}" for n in missing]
+    at_ends = f"{ends} before img/{frames[0].name} or after img/{frames[-1].name}" if ends > 0 else ""
+    return f"{said}: missing " + "; ".join(filter(None, [listed(names), at_ends]))
+
+
+def listed(names: list[str], shown: int = 3) -> str:
+    """The first ``shown`` of ``names``, and how many in all where there are more."""
+    return ", ".join(names[:shown]) + (f" ... ({len(names)} in all)" if len(names) > shown else "")
+
+
 def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str | None]]:
     """Everything checked before any work: ``(runs, skipped, (backend, n_jobs, address))``.
 
@@ -154,6 +201,7 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
 
         load_own_papers(resolve(str(cfg.claims_dir)))
     check_scenes(cfg)
+    check_frames(cfg)
     check_conditions(cfg)
     skipped: list[str] = []
     runs = expand(cfg, skipped)

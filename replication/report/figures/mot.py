@@ -24,6 +24,7 @@ from matplotlib.colors import to_rgb
 from matplotlib.patches import Rectangle
 from PIL import Image
 
+from replication import atomic
 from replication.metrics.mot import BOX, clear_mot_matches
 from replication.condition import PREFIX, values_of
 from replication.display import method_label
@@ -313,8 +314,8 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
         images.append(Image.fromarray(index, "P"))
         images[-1].putpalette(palette)
         shown = np.asarray(images[-1].convert("RGB")).astype(np.int16)
-    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0,
-                   optimize=True, disposal=1)
+    atomic.save(path, lambda tmp: images[0].save(tmp, "GIF", save_all=True, append_images=images[1:], loop=0,
+                                                 duration=round(1000 / fps), optimize=True, disposal=1))
     return path
 
 

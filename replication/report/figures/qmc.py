@@ -6,6 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from replication import atomic
 from replication.qmc import discrepancy, point_set
 from replication.report.figures.base import figure
 
@@ -26,6 +27,6 @@ def point_sets(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         ax.set_xlim(0, 1)
         ax.set_ylim(0, 1)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    atomic.save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path

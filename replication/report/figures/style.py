@@ -17,6 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import to_rgb
 
+from replication import atomic
 from replication.display import COLOURS, LINES, MARKERS, Look, asked_look
 from replication.errors import ConfigError
 from replication.filters.registry import builder
@@ -126,6 +127,6 @@ class NothingToDraw(ValueError):
 def save(fig, path: Path, dpi: int = 110) -> Path:
     """Lay out, write and close a figure; the image takes in what lies outside the axes (a legend below)."""
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
+    atomic.save_figure(fig, path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
     plt.close(fig)
     return path

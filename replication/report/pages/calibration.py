@@ -25,6 +25,7 @@ import pandas as pd  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
+from replication import atomic  # noqa: E402
 from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import detectable  # noqa: E402
   # noqa: E402
@@ -54,8 +55,8 @@ def load_or_calibrate(reports: Path, replications: int = calibration.REPLICATION
     with tqdm(total=len(calibration.cases()), desc="calibration", unit="rule") as bar:
         table = calibration.calibrate(replications, progress=lambda done, total: bar.update(1))
     reports.mkdir(parents=True, exist_ok=True)
-    table.to_csv(csv, index=False)
-    note.write_text(json.dumps(wanted, indent=1))
+    atomic.save(csv, lambda tmp: table.to_csv(tmp, index=False))
+    atomic.write_text(note, json.dumps(wanted, indent=1))
     return table
 
 
@@ -93,7 +94,7 @@ def draw_null_rates(table: pd.DataFrame, path: Path) -> None:
     ax.legend(handles=handles, fontsize=7, loc="lower right")
     ax.set_title("Error rates under the null (colour: run count, 5 to 100)", fontsize=9, loc="left")
     fig.tight_layout()
-    fig.savefig(path, dpi=110, bbox_inches="tight")  # the rules' names are long
+    atomic.save_figure(fig, path, dpi=110, bbox_inches="tight")  # the rules' names are long
     plt.close(fig)
 
 
@@ -117,7 +118,7 @@ def draw_power(table: pd.DataFrame, path: Path) -> None:
     axes[0].set_ylabel("share reproduced")
     axes[1].legend(fontsize=6, ncol=1, loc="center right")
     fig.tight_layout()
-    fig.savefig(path, dpi=110, bbox_inches="tight")  # the rules' names are long
+    atomic.save_figure(fig, path, dpi=110, bbox_inches="tight")  # the rules' names are long
     plt.close(fig)
 
 
@@ -131,7 +132,7 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     shown = table.drop(columns=["holds", "replications"]).round({"rate": 4, "mc_se": 4, "wrong_rate": 4,
                                                                    "power": 4})
     page = out / "index.html"
-    page.write_text(render(
+    atomic.write_text(page, render(
         "calibration.html.j2", title="How often the verdict rules err: calibration",
         failed=failures(table), controls=failures(table, control=True), table=html_table(shown), replications=int(table["replications"].max()),
         rows=len(table), floor=2.0 ** -5, equivalence_alpha=INFERENCE.equivalence_alpha,

@@ -12,6 +12,7 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 import replication
+from replication import atomic
 from replication.evidence.claims import Result, evaluate, load_own_papers
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
@@ -22,6 +23,7 @@ from replication.evidence.published import cells, load_published, published_path
 from replication.report.pages.render import html_table, render
 from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
+from replication.scales import index_from, report_folder
 from replication.report.figures.style import NothingToDraw
 from replication.evidence.tables import TableKind
 from replication.scenes.factory import cached_sequence, scene_kind
@@ -30,9 +32,10 @@ from replication.runner.variant import SHOWN
 
 
 def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
-    """Write ``<reports>/<experiment>/`` from an experiment's stored ``results``; return the page's path."""
+    """Write ``<reports>/<experiment>/`` (at the quick scale ``<reports>/quick/<experiment>/``) from an
+    experiment's stored ``results``; return the page's path."""
     experiment, runs, records, failures = results.experiment, results.runs, results.records, results.failures
-    out = resolve(cfg.reports) / results.name
+    out = report_folder(resolve(cfg.reports), results.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
     spec = experiment.get("report", {})
@@ -47,9 +50,9 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
                 continue
             built[table_spec["name"]] = table
             csv = f"{table_spec['name']}.csv"
-            table.written().to_csv(out / csv, index=False)
+            atomic.save(out / csv, lambda tmp: table.written().to_csv(tmp, index=False))
             html = html_table(table.shown())
-            (out / f"{table_spec['name']}.html").write_text(html)
+            atomic.write_text(out / f"{table_spec['name']}.html", html)
             tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv,
                            "note": table.note})
         for figure_spec in spec.get("figures", []):
@@ -70,12 +73,13 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     # methods), only the user's own claims (claims_dir), by the same rules
     own = load_own_papers(resolve(cfg.claims_dir)) if results.own and cfg.get("claims_dir") else ()
     claims = evaluate(experiment["name"], experiment, records, built, published, own if results.own else None)
-    changes = scale_changes(OmegaConf.to_container(cfg.experiment, resolve=True))
+    changes = scale_changes(results.at_paper_scale, experiment)
     paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
     page = out / "index.html"
-    page.write_text(
+    atomic.write_text(
+        page,
         render(
             "experiment.html.j2",
             title=experiment.get("title", experiment["name"]),
@@ -99,6 +103,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
             scale_note=scale_note(cfg.scale, changes),
             provenance=_provenance(records),
             name=results.name,
+            home=index_from(results.name, cfg.scale),  # the reports' index, from this page's folder
             changes=results.changes[:SHOWN],
             more_changes=max(len(results.changes) - SHOWN, 0),
             sweeps=sorted(p.stem for p in (out / "sweeps").glob("*.html")),

@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
+from replication import atomic  # noqa: E402
 from replication.evidence.claims import Check, Paper  # noqa: E402
 from replication.evidence.scorecard import ClaimRow  # noqa: E402
 from replication.evidence.statistics import Estimate, said_level  # noqa: E402
@@ -156,6 +157,6 @@ def draw(by_paper: dict[str, list[Line]], path: Path) -> Path:
              "\"every reading\": robust when no open choice of the paper's multiverse moves the verdict.",
              fontsize=7, color="0.3")
     path = Path(path)
-    fig.savefig(path, dpi=100)
+    atomic.save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path

@@ -1,6 +1,10 @@
 """``reports/index.html``: the scorecard of every paper's claims, every published cell against ours,
 then every experiment with a report, linked.
 
+Each scale's reports live apart (:func:`~replication.scales.report_folder`: ``<name>/`` at the paper scale,
+``quick/<name>/`` at the quick one); the scorecard reads an experiment's paper-scale report where there is one,
+else its quick one, and says which beside each verdict; the tables of experiments list both.
+
 The scorecard (:mod:`replication.evidence.scorecard`) is also written as
 ``reports/claims.csv``, and the summary of every published cell
 (:mod:`replication.evidence.summary`) as ``reports/summary.csv``.
@@ -10,6 +14,7 @@ import datetime
 from pathlib import Path
 
 import replication
+from replication import atomic
 from replication.paths import experiment_names
 from replication.evidence.claims import load_papers
 from replication.evidence.published import load_published, published_path
@@ -18,6 +23,7 @@ from replication.report.pages import glance
 from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
+from replication.scales import QUICK_REPORTS, SCALES, page_link
 from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
 from replication.evidence.schema import Summary
 from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table
@@ -27,17 +33,20 @@ TITLE = "Particle-filter tracking papers: replication report"
 
 
 def _scale_note(summaries: dict[str, Summary]) -> str | None:
-    """The banner when any stored report is below the paper's scale (each experiment's page lists its changes)."""
+    """The banner when any verdict on the scorecard comes from a report below the paper's scale (each
+    experiment's page lists its changes)."""
     quick = [name for name, s in summaries.items() if s.scale != "paper"]
     if not quick:
         return None
-    return (f"{len(quick)} of {len(summaries)} experiments are at the quick scale. {scale_note('quick')} "
-            f"Each experiment's page lists what quick changes for it.")
+    return (f"The verdicts of {len(quick)} of {len(summaries)} experiments are at the quick scale (their pages: "
+            f"{QUICK_REPORTS}/), each marked so beside it. {scale_note('quick')} Each experiment's page lists what "
+            f"quick changes for it.")
 
 
 def _entry(name: str, summary: Summary) -> dict:
     """A report's row in the index's tables of experiments."""
-    return {"name": name, "title": summary.title, "paper": summary.paper, "scale": summary.scale,
+    return {"name": name, "link": page_link(summary.name, summary.scale), "title": summary.title,
+            "paper": summary.paper, "scale": summary.scale,
             "n_records": summary.n_records, "n_runs": summary.n_runs, "failed": summary.failed,
             "verdicts": ", ".join(f"{k}: {v}" for k, v in sorted(summary.verdicts.items())) or "-",
             "ablation": "ablation" in name,  # the studies on top of the papers get their own section
@@ -56,22 +65,28 @@ def _findings(reports: Path, paper: str) -> str | None:
 
 def write_index(reports: Path, published_values: str | Path | None = None) -> Path:
     reports = Path(reports)
-    summaries = load_summaries(reports)
+    summaries = load_summaries(reports)  # what the scorecard reads: each experiment's at one scale
     missing = [name for name in experiment_names() if name not in summaries]
-    experiments = [_entry(name, summary) for name, summary in summaries.items()]
-    own = [_entry(name, summary) for name, summary in load_summaries(reports, own=True).items()]
+    pages = {scale: load_summaries(reports, scales=(scale,)) for scale in SCALES}  # every page, at both scales
+    experiments = [_entry(name, pages[scale][name]) for name in experiment_names() for scale in SCALES
+                   if name in pages[scale]]
+    own = [_entry(name, summary) for scale in SCALES
+           for name, summary in load_summaries(reports, own=True, scales=(scale,)).items()]
     published = load_published(str(published_path(published_values)))
     papers = load_papers()
     rows = claim_rows(papers, summaries)
     record = recorded(reports, papers)
     cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
-    cells.drop(columns=["link_text"]).to_csv(reports / "summary.csv", index=False)
+    shown = cells.drop(columns=["link_text"])
+    atomic.save(reports / "summary.csv", lambda tmp: shown.to_csv(tmp, index=False))
     tallies = cell_tallies(cells)
-    claims_frame(rows, cells, tallies).to_csv(reports / "claims.csv", index=False)
+    claims = claims_frame(rows, cells, tallies)
+    atomic.save(reports / "claims.csv", lambda tmp: claims.to_csv(tmp, index=False))
     glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
     page = reports / "index.html"
-    page.write_text(
+    atomic.write_text(
+        page,
         render(
             "index.html.j2",
             title=TITLE,
@@ -83,6 +98,7 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
                      "cells": int((cells["paper"] == paper.key).sum()), "findings": _findings(reports, paper.key)}
                     for paper in papers],
             scale_note=_scale_note(summaries),
+            links={name: page_link(s.name, s.scale) for name, s in summaries.items()},  # the scorecard's evidence
             record=record,
             tallies=tallies,
             rules=rules(),

@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
+from replication import atomic
 from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import load_published, published_path
@@ -27,6 +28,7 @@ from replication.evidence.statistics import said_level
 from replication.paths import resolve
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
+from replication.scales import index_from, report_folder
 from replication.report.figures.style import OUTCOME_COLOURS
 from replication.evidence.tables import TableKind
 from replication.runner.multiverse import Multiverse
@@ -103,7 +105,7 @@ def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> No
                for outcome, colour in OUTCOME_COLOURS.items()]
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=7, frameon=False)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    fig.savefig(path, dpi=110, bbox_inches="tight")  # universes' names can be long
+    atomic.save_figure(fig, path, dpi=110, bbox_inches="tight")  # universes' names can be long
     plt.close(fig)
 
 
@@ -115,10 +117,11 @@ def _headline(robustness: Robustness) -> str | None:
 
 def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
                             store_of=None) -> Path:
-    """``<reports>/<paper>_readings/``: the choices, the universes run, each claim's robustness with every
-    case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard.  ``store_of(experiment,
-    universe)`` holds the runs (the store by default; the paper-scale record's universe)."""
-    out = resolve(cfg.reports) / multiverse.name
+    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``): the choices, the universes
+    run, each claim's robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for
+    the scorecard.  ``store_of(experiment, universe)`` holds the runs (the store by default; the paper-scale
+    record's universe, or the record beneath the store: :mod:`replication.record.layer`)."""
+    out = report_folder(resolve(cfg.reports), multiverse.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
     store_of = store_of or (lambda name, universe: Store(resolve(cfg.store), name))
@@ -127,12 +130,13 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: 
     frame = pd.DataFrame([{"claim_id": r.claim.id, "universe": c.universe, **{k: v for k, v in c.picks},
                            "verdict": c.verdict.outcome.value, "why": c.verdict.why,
                            "number": c.deciding.number if c.deciding else ""} for r in robustness for c in r.cases])
-    frame.to_csv(out / "cases.csv", index=False)
+    atomic.save(out / "cases.csv", lambda tmp: frame.to_csv(tmp, index=False))
     n_runs = sum(len(runs) for runs in multiverse.runs.values())  # per universe: a shared run in each
     page = out / "index.html"
-    page.write_text(render(
+    atomic.write_text(page, render(
         "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
         robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
+        home=index_from(multiverse.name, cfg.scale),
         scale_note=scale_note(cfg.scale), config=OmegaConf.to_yaml(cfg.experiment),
         command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))

@@ -9,6 +9,7 @@ writes :data:`STATUS` there (:func:`write_status`); ``pf-replicate verify agains
 import json
 from pathlib import Path
 
+from replication import atomic
 from replication.evidence.claims import Paper
 from replication.evidence.scorecard import ClaimRow, claim_rows
 from replication.evidence.summary import load_summaries
@@ -46,7 +47,7 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
         "profile": profile,
     }
     path = out / STATUS
-    path.write_text(json.dumps(status, indent=1) + "\n")
+    atomic.write_text(path, json.dumps(status, indent=1) + "\n")
     return path
 
 

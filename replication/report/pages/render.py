@@ -10,6 +10,8 @@ import pandas as pd
 from jinja2 import Environment, PackageLoader, select_autoescape
 from markupsafe import Markup
 
+from replication import atomic
+
 ENVIRONMENT = Environment(
     loader=PackageLoader("replication.report.pages", "templates"),
     autoescape=select_autoescape(["html", "htm", "xml", "html.j2"]),  # the templates are *.html.j2: escape every value
@@ -45,12 +47,14 @@ def open_in_browser(page: Path, screenshot: Path | None = None, size=(1280, 2000
         binary, "--headless", "--disable-gpu", "--no-sandbox", "--hide-scrollbars", "--enable-logging=stderr",
         "--v=0", f"--window-size={size[0]},{size[1]}", "--dump-dom",
     ]
-    if screenshot is not None:
-        command.append(f"--screenshot={Path(screenshot).resolve()}")
     url = Path(page).resolve().as_uri()
     with tempfile.TemporaryDirectory(prefix="chromium-") as profile:  # a fresh profile, nothing left in ~
-        done = subprocess.run([*command, f"--user-data-dir={profile}", url], capture_output=True, text=True,
-                              timeout=timeout)
+        shot = Path(profile) / "screenshot.png"  # taken here, then put in place whole (replication.atomic)
+        taking = [f"--screenshot={shot}"] if screenshot is not None else []
+        done = subprocess.run([*command, *taking, f"--user-data-dir={profile}", url], capture_output=True,
+                              text=True, timeout=timeout)
+        if screenshot is not None and done.returncode == 0 and shot.exists():
+            atomic.save(screenshot, lambda tmp: shutil.copyfile(shot, tmp))
     console = [line.split("] ", 1)[-1] for line in done.stderr.splitlines() if ":CONSOLE" in line]
     if done.returncode != 0:
         raise RuntimeError(f"{binary} exited {done.returncode}: {done.stderr[-2000:]}")

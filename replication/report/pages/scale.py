@@ -2,8 +2,9 @@
 
 An experiment config writes ``{paper: a, quick: b}`` wherever the scale
 matters (run counts, frames of a scene, the last frame of a real sequence);
-:func:`scale_changes` lists those, so the banner cannot fall out of step with
-the configs.
+:func:`scale_changes` lists where the experiment as run differs from the same at
+the paper's scale, so the banner cannot fall out of step with the configs, and
+names the sequences the page ran (a user's own, not the shipped ones they replace).
 """
 
 from replication.evidence.inference import detectable
@@ -14,18 +15,21 @@ PAPER_COMMAND = "make replicate SCALE=paper"
 SCALED = ("runs", "scenes", "model", "methods")  # where a config's scale takes effect (not its YAML anchors)
 
 
-def scale_changes(config: dict, path: str = "") -> list[str]:
-    """Every ``{paper: a, quick: b}`` in an experiment config (before its scale is applied), as
-    ``'<where>: a -> b'`` (``all`` for a null: every frame)."""
-    if isinstance(config, dict):
-        if set(config) == {"paper", "quick"}:
-            shown = ["all" if v is None else str(v) for v in (config["paper"], config["quick"])]
-            return [f"{_where(path)}: {shown[0]} -> {shown[1]}"] if shown[0] != shown[1] else []
-        return [change for key, value in config.items() if path or key in SCALED
-                for change in scale_changes(value, f"{path}.{key}")]
-    if isinstance(config, list):
-        return [change for i, value in enumerate(config) for change in scale_changes(value, f"{path}[{i}]")]
-    return []
+def scale_changes(paper: dict, scaled: dict, path: str = "") -> list[str]:
+    """What ``scaled`` (an experiment's config at a scale, as run: its real sequences located, a user's own in
+    place of the shipped ones) changes from ``paper`` (the same at the paper's scale), as ``'<where>: a -> b'``
+    (``all`` for a null: every frame)."""
+    if isinstance(paper, dict) and isinstance(scaled, dict):
+        return [change for key in paper if key in scaled and (path or key in SCALED)
+                for change in scale_changes(paper[key], scaled[key], f"{path}.{key}")]
+    if isinstance(paper, list) and isinstance(scaled, list) and len(paper) == len(scaled) \
+            and any(isinstance(value, dict) for value in paper):
+        return [change for i, (a, b) in enumerate(zip(paper, scaled))
+                for change in scale_changes(a, b, f"{path}[{i}]")]
+    if paper == scaled:
+        return []
+    shown = ["all" if v is None else str(v) for v in (paper, scaled)]
+    return [f"{_where(path)}: {shown[0]} -> {shown[1]}"]
 
 
 def _where(path: str) -> str:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from replication import atomic
 from replication.condition import values_of
 from replication.report.figures import draw
 from replication.report.figures.style import NothingToDraw
@@ -39,8 +40,8 @@ def write_sequence_pages(records: pd.DataFrame, experiment: dict, out: Path) -> 
                              "link": f"{scene}/{figure['link']}" if "link" in figure else None})
         what = experiment["scenes"][scene].get("name", scene)
         page = out / "sequences" / f"{scene}.html"
-        page.write_text(render("sections.html.j2", title=f"{experiment['name']}: {what}", up="../index.html",
-                               up_label=experiment["name"], meta=f"{len(runs)} runs on {what} (scene {scene})",
-                               sections=sections))
+        atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: {what}",
+                                       up="../index.html", up_label=experiment["name"],
+                                       meta=f"{len(runs)} runs on {what} (scene {scene})", sections=sections))
         links.append({"scene": scene, "link": f"sequences/{scene}.html", "what": what})
     return links

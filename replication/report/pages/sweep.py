@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from replication import atomic
 from replication.condition import PREFIX, label_of
 from replication.errors import ConfigError
 from replication.evidence.aggregate import summarise
@@ -78,7 +79,7 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
     tagged = tagged.assign(condition=label_of(tagged))
     tagged = pd.concat([tagged, records[same & (records["swept"] == records["swept"].iloc[0])]])
     table = summarise(tagged, metric)
-    table.to_csv(out / f"{stem}.csv", index=False)
+    atomic.save(out / f"{stem}.csv", lambda tmp: table.to_csv(tmp, index=False))
     sections = []
     numeric = pd.to_numeric(records["swept"], errors="coerce").notna().all()
     if numeric:  # a line against the value; a categorical sweep (a scheme's name) is the table alone
@@ -93,6 +94,6 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
     meta = f"Drawn from the store by: {command}. " + (
         "Missing: " + "; ".join(missing) + ". Run the multirun to store them." if missing else "Every run is stored."
     )
-    page.write_text(render("sections.html.j2", title=f"{experiment['name']}: sweep of {key}", up="../index.html",
-                           up_label=experiment["name"], meta=meta, sections=sections))
+    atomic.write_text(page, render("sections.html.j2", title=f"{experiment['name']}: sweep of {key}",
+                                   up="../index.html", up_label=experiment["name"], meta=meta, sections=sections))
     return page
