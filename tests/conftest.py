@@ -1,3 +1,4 @@
+import gc
 import os
 import signal
 import sys
@@ -20,12 +21,13 @@ def pytest_configure(config):
 
 
 @pytest.fixture(autouse=True)
-def project_home_restored():
+def process_state_restored():
     """The command line sets ``$REPLICATION_HOME`` for its workers; a test that calls it in-process must not
     leave it to the tests after it in the same worker, whose subprocesses would then resolve their store in
     this checkout (a copy of the project ran its runs into this clone's ``experiments/``)."""
     saved = os.environ.get(HOME_VARIABLE)
     yield
+    gc.unfreeze()  # the command line freezes the heap for its exit (lifeline.exit_uncollected); a test is no exit
     if saved is None:
         os.environ.pop(HOME_VARIABLE, None)
     else:
