@@ -2,8 +2,8 @@
 
 Every such tracker has one method, ``track(sequence, frames, rng)``, which owns the time loop
 over a :class:`~replication.scenes.mot.MotSequence`'s ``frames`` (MOT numbers) and yields,
-per frame, the ids (from 1) and (x, y, w, h) boxes it outputs; ``seconds`` adds up its
-own time (decoding the frames excluded, as bis_pf's timings exclude it).
+per frame, the ids (from 1) and (x, y, w, h) boxes it outputs; its ``stopwatch`` adds up its
+own time on both clocks (decoding the frames excluded, as bis_pf's timings exclude it).
 
 * :class:`ParticleTracker`: a joint filter of :mod:`replication.filters.bis` (MIPF,
   BIS-PF, MFMC, DMOT, MCMC-PF) over the targets alive, with the births, deaths and
@@ -21,7 +21,6 @@ associated with them, as SORT outputs; ``alive``, every frame of a track's life)
 with its colour reference from its first detection's box in this frame.
 """
 
-import time
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -37,6 +36,7 @@ from replication.filters.registry import drawn
 from replication.filters.track_management import Deleter, Initiator, associate
 from replication.metrics.mot import BOX
 from replication.models.box import BoxModel
+from replication.stopwatch import Stopwatch
 
 # Which of a live track's frames are output, from whether a detection is associated with it this frame and
 # whether it is supported (a detection or its colour, :class:`Deleter`).
@@ -71,7 +71,7 @@ class ParticleTracker:
     association_iou: float = 0.3  # not stated: our choice, SORT's gate
     min_score: float = -np.inf  # detections below are ignored
     output: str = "supported"
-    seconds: float = field(default=0.0, init=False)
+    stopwatch: Stopwatch = field(default_factory=Stopwatch, init=False)
     born: int = field(default=0, init=False)  # tracks started
     counts: Counter = field(default_factory=Counter, init=False)  # where the tracks' frames went (EVENTS)
 
@@ -85,42 +85,43 @@ class ParticleTracker:
         ids, boxes, unsupported = np.zeros(0, int), np.zeros((0, 4)), np.zeros(0, int)
         for frame in frames:
             image = sequence.image(frame)
-            started = time.perf_counter()
-            found = detections.get(frame, np.zeros((0, 4)))
-            assigned = associate(boxes, found, self.association_iou)
-            for model, index in zip(state.models, assigned):
-                model.detection = centre_boxes(found[index]) if index >= 0 else None
-            if len(ids):
-                self.method.step(state, image)
-                means = np.array([records.means[-1][:4] for records in state.records])
-                boxes = corner_boxes(means)
-                rho = np.array([model.similarity(mean[None], image, state.t)[0] for model, mean in zip(state.models, means)])
-                detected = assigned >= 0
-                supported = self.deaths.supported(detected, rho)
-                unsupported = np.where(supported, 0, unsupported + 1)
-                causes = self.deaths.causes(unsupported, boxes, sequence.size)
-                dead = causes["unsupported"] | causes["outside"]
-                shown = ~dead & OUTPUTS[self.output](detected, supported)
-                self.counts.update({"track_frames": len(ids), "detected_frames": int(detected.sum()),
-                                    "colour_frames": int((supported & ~detected).sum()), "shown_frames": int(shown.sum()),
-                                    "died_unsupported": int((dead & causes["unsupported"]).sum()),
-                                    "died_outside": int((dead & ~causes["unsupported"]).sum())})
-                out_ids, out_boxes = ids[shown], boxes[shown]
-                for index in np.flatnonzero(dead)[::-1]:
-                    self.method.remove(state, int(index))
-                ids, boxes, unsupported = ids[~dead], boxes[~dead], unsupported[~dead]
-            else:
-                out_ids, out_boxes = ids, boxes
-            taken = np.isin(np.arange(len(found)), assigned)
-            born = self.births.step(found[~taken], boxes)
-            for box in born:
-                self.method.add(state, self.new_model(image, centre_boxes(box)))
-            new_ids = np.arange(self.born + 1, self.born + len(born) + 1)
-            self.counts.update({"births": len(born), "shown_frames": len(born)})
-            self.born += len(born)
-            ids, boxes = np.concatenate([ids, new_ids]), np.vstack([boxes, born])
-            unsupported = np.concatenate([unsupported, np.zeros(len(born), int)])
-            self.seconds += time.perf_counter() - started
+            with self.stopwatch:
+                found = detections.get(frame, np.zeros((0, 4)))
+                assigned = associate(boxes, found, self.association_iou)
+                for model, index in zip(state.models, assigned):
+                    model.detection = centre_boxes(found[index]) if index >= 0 else None
+                if len(ids):
+                    self.method.step(state, image)
+                    means = np.array([records.means[-1][:4] for records in state.records])
+                    boxes = corner_boxes(means)
+                    rho = np.array([model.similarity(mean[None], image, state.t)[0]
+                                    for model, mean in zip(state.models, means)])
+                    detected = assigned >= 0
+                    supported = self.deaths.supported(detected, rho)
+                    unsupported = np.where(supported, 0, unsupported + 1)
+                    causes = self.deaths.causes(unsupported, boxes, sequence.size)
+                    dead = causes["unsupported"] | causes["outside"]
+                    shown = ~dead & OUTPUTS[self.output](detected, supported)
+                    self.counts.update({"track_frames": len(ids), "detected_frames": int(detected.sum()),
+                                        "colour_frames": int((supported & ~detected).sum()),
+                                        "shown_frames": int(shown.sum()),
+                                        "died_unsupported": int((dead & causes["unsupported"]).sum()),
+                                        "died_outside": int((dead & ~causes["unsupported"]).sum())})
+                    out_ids, out_boxes = ids[shown], boxes[shown]
+                    for index in np.flatnonzero(dead)[::-1]:
+                        self.method.remove(state, int(index))
+                    ids, boxes, unsupported = ids[~dead], boxes[~dead], unsupported[~dead]
+                else:
+                    out_ids, out_boxes = ids, boxes
+                taken = np.isin(np.arange(len(found)), assigned)
+                born = self.births.step(found[~taken], boxes)
+                for box in born:
+                    self.method.add(state, self.new_model(image, centre_boxes(box)))
+                new_ids = np.arange(self.born + 1, self.born + len(born) + 1)
+                self.counts.update({"births": len(born), "shown_frames": len(born)})
+                self.born += len(born)
+                ids, boxes = np.concatenate([ids, new_ids]), np.vstack([boxes, born])
+                unsupported = np.concatenate([unsupported, np.zeros(len(born), int)])
             yield frame, np.concatenate([out_ids, new_ids]), np.vstack([out_boxes, born])
 
 
@@ -129,14 +130,13 @@ class DetectionTracker:
     """A reference tracker on the detections alone: ``link(detections)`` gives the whole track table."""
 
     link: Callable[[pd.DataFrame], pd.DataFrame]
-    seconds: float = field(default=0.0, init=False)
+    stopwatch: Stopwatch = field(default_factory=Stopwatch, init=False)
     counts: Counter = field(default_factory=Counter, init=False)  # no particles: no EVENTS
 
     def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
         frames = list(frames)
-        started = time.perf_counter()
-        table = self.link(sequence.detections[sequence.detections["frame"].isin(frames)])
-        self.seconds += time.perf_counter() - started
+        with self.stopwatch:
+            table = self.link(sequence.detections[sequence.detections["frame"].isin(frames)])
         by_frame = {frame: rows for frame, rows in table.groupby("frame")}
         for frame in frames:
             rows = by_frame.get(frame, table.iloc[:0])

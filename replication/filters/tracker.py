@@ -25,7 +25,6 @@ independent tracker draws target k's from ``filter<k>``, a joint one its single
 stream from ``filter``, as the task did before this interface, so numbers stay.
 """
 
-import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Iterator, Mapping
 
@@ -34,6 +33,7 @@ import numpy as np
 from replication.filters.frame import Targets, independent_frame
 from replication.filters.joint import JointFilter
 from replication.smc.loop import FilterOutput
+from replication.stopwatch import Stopwatch
 
 Streams = Callable[[str], np.random.Generator]
 
@@ -43,7 +43,8 @@ class Tracker(ABC):
 
     targets: list
     models: list
-    frame_seconds: list[float]  # time spent in each ``step`` by ``track`` (frame production excluded)
+    frame_seconds: list[float]  # wall time spent in each ``step`` by ``track`` (frame production excluded)
+    stopwatch: Stopwatch  # both clocks over every ``step`` of ``track`` (its ``cpu``: this thread's CPU time)
     adapts: bool = False  # whether the models adapt at the estimates after each step
 
     @abstractmethod
@@ -65,15 +66,16 @@ class Tracker(ABC):
     def track(self, frames: Iterable, collectors: Iterable["Collector"] = ()) -> Iterator[list[np.ndarray]]:
         """Step through ``frames`` (frame 1 on), calling every collector after each step; yields the estimates.
 
-        ``frame_seconds`` holds the time in :meth:`step` only, one entry per frame: producing a
-        frame (rendering, decoding) is the iterator's, and collectors are not the tracker's cost.
+        ``frame_seconds`` holds the wall time in :meth:`step` only, one entry per frame, and ``stopwatch``
+        both clocks summed: producing a frame (rendering, decoding) is the iterator's, and collectors are
+        not the tracker's cost.
         """
         collectors = list(collectors)
-        self.frame_seconds = []
+        self.frame_seconds, self.stopwatch = [], Stopwatch()
         for frame in frames:
-            started = time.perf_counter()
-            estimates = self.step(frame)
-            self.frame_seconds.append(time.perf_counter() - started)
+            with self.stopwatch:
+                estimates = self.step(frame)
+            self.frame_seconds.append(self.stopwatch.last_wall)
             for collector in collectors:
                 collector.collect(self)
             yield estimates

@@ -4,7 +4,7 @@ One :class:`Entry` per experiment, read off its runs' own provenance: how many r
 commits and code digests that computed them, the libraries and CPU and the code paths the libraries took
 on it (``machine_details``, :class:`~replication.runner.machine.Machine`: ``null`` where the runs were
 computed before they said, as every run of the record at f29efe1 was), when the first and last were
-computed and their summed wall time; and of its files, the SHA-256 of each and their size
+computed, their summed wall and CPU times and the machine's load as they ended; and of its files, the SHA-256 of each and their size
 (:meth:`Manifest.damaged` names a file that no longer matches).  An entry that replaces another keeps
 what the one it replaced took (:class:`Before`), so that a change of code shows its cost beside the old.
 """
@@ -56,6 +56,10 @@ class Entry:
     universes: int = 0  # a multiverse's universes recorded (0: an experiment)
     before: Before | None = None  # the recording this entry replaced
     machine_details: tuple[Machine, ...] | None = None  # the code paths of its runs' machines (None: not recorded)
+    # summed over the runs: each run's thread CPU time; and the machine's 1-minute load as they ended, median and
+    # max (None: runs recorded before they said)
+    cpu_s: float | None = None
+    load_1m: tuple[float, float] | None = None
 
     @property
     def minutes(self) -> float | None:
@@ -93,7 +97,7 @@ class Entry:
             libraries=tuple(sorted({", ".join(f"{k.removesuffix('_version')} {r.get(k)}" for k in LIBRARIES)
                                     for r in rows if not r.get("failure")})),
             machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat(), universes=universes,
-            machine_details=_machines(rows))
+            machine_details=_machines(rows), cpu_s=_summed(distinct, "cpu_s"), load_1m=_load(rows))
 
 
 @dataclass(frozen=True)
@@ -157,6 +161,18 @@ def _machines(rows: list[dict]) -> tuple[Machine, ...] | None:
 
 def _read_machines(data: list[dict] | None) -> tuple[Machine, ...] | None:
     return None if data is None else tuple(Machine.of(d) for d in data)
+
+
+def _summed(rows, key: str) -> float | None:
+    """The sum of ``key`` over ``rows`` (None where no row has it)."""
+    values = [r[key] for r in rows if r.get(key) is not None]
+    return round(sum(values), 1) if values else None
+
+
+def _load(rows: list[dict]) -> tuple[float, float] | None:
+    """The median and maximum of the rows' ``load_1m`` (None where no row has it)."""
+    values = sorted(r["load_1m"] for r in rows if r.get("load_1m") is not None)
+    return (values[len(values) // 2], values[-1]) if values else None
 
 
 def _distinct(rows: list[dict], key: str) -> tuple:

@@ -23,7 +23,6 @@ import signal
 import socket
 import sys
 import threading
-import time
 import warnings
 from collections.abc import Iterator
 from contextlib import closing, contextmanager, nullcontext
@@ -42,10 +41,12 @@ from replication.runner.lifeline import start_worker
 from replication.runner.memory import one_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
+from replication.stopwatch import Stopwatch, load_1m
 from replication.tasks import TASKS
 
 # machine- and moment-dependent: left out of determinism checks
-TIMING_COLUMNS = ("wall_s", "ms_per_step", "ms_per_frame", "filter_s", "fps", "computed_at")
+TIMING_COLUMNS = ("wall_s", "cpu_s", "ms_per_step", "cpu_ms_per_step", "ms_per_frame", "cpu_ms_per_frame", "filter_s",
+                  "cpu_filter_s", "fps", "load_1m", "computed_at")
 BACKENDS = ("loky", "threading", "dask", "ray")
 CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
 # ray's joblib backend returns whole lists only (no return_as="generator_unordered"): its records are
@@ -77,18 +78,20 @@ def perform(run: Run) -> dict:
 
 
 def _performed(run: Run) -> dict:
-    started = time.perf_counter()
-    try:
-        metrics = TASKS[run.task].run(run)
-        reason = failure(metrics)
-    except RunFailed as error:
-        reason = str(error)
+    with Stopwatch() as stopwatch:
+        try:
+            metrics = TASKS[run.task].run(run)
+            reason = failure(metrics)
+        except RunFailed as error:
+            reason = str(error)
     if reason:
         return {"run_id": run.run_id, "failure": reason}
     return {
         **run.identity(),
         **metrics,
-        "wall_s": time.perf_counter() - started,
+        "wall_s": stopwatch.wall,
+        "cpu_s": stopwatch.cpu,  # this thread's: the run's own work, whatever else the machine did
+        "load_1m": load_1m(),  # the machine's, as the run ended: above its cores, runs waited for one
         "base_seed": run.base_seed,
         "replication_version": replication.__version__,
         **provenance(),

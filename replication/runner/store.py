@@ -38,8 +38,8 @@ systems and on NFS), readable by the group under the usual umask.  So
   compute the same run (both started before either finished), the second
   rename simply replaces the first file, and since a run is a pure function
   of its identity and seed both records agree in every column except the
-  wall-clock timings (``execute.TIMING_COLUMNS``) -- the last writer's
-  timings are kept.  (That holds for machines with the same numpy, scipy
+  timings and the machine's load (``execute.TIMING_COLUMNS``) -- the last writer's
+  are kept.  (That holds for machines with the same numpy, scipy
   and Python: the key covers this package's code only, and the records
   carry the library versions, machine and git commit to show where they came from.)
 * work can be duplicated, not results: nothing locks a run while it is

@@ -154,9 +154,10 @@ def run(run: Run) -> dict:
         "tracks_per_person": tracks["id"].nunique() / people if people else float("nan"),
         **breakdown(tracker.counts, run.model.get("proposal", {}).get("alpha", 0.5)),
         **({"detection_iou": detection_overlap(tracks, used)} if len(tracks) else {}),
-        "ms_per_frame": 1000.0 * tracker.seconds / len(frames),
+        "ms_per_frame": 1000.0 * tracker.stopwatch.wall / len(frames),
+        "cpu_ms_per_frame": 1000.0 * tracker.stopwatch.cpu / len(frames),
         **work.record(len(frames)),
-        "fps": len(frames) / tracker.seconds if tracker.seconds > 0 else float("inf"),
+        "fps": len(frames) / tracker.stopwatch.wall if tracker.stopwatch.wall > 0 else float("inf"),
         "tracks": tracks.to_numpy(float).tolist(),
     }
 

@@ -1,13 +1,12 @@
 """One filter on one simulated trajectory of a scalar state-space model."""
 
-import time
-
 from replication.filters.registry import build_filter
 from replication.metrics import filter_diagnostics, rmse
 from replication.models import MODELS
 from replication.run import Run
 from replication.smc.loop import expect_output
 from replication.smc.work import Counted, Work
+from replication.stopwatch import Stopwatch
 
 
 def build_model(params: dict):
@@ -31,13 +30,13 @@ def run(run: Run) -> dict:
     model = build_model(run.model)
     states, observations = model.simulate(run.rng("data"))
     method, work = build_filter(run.method, run.method_params), Work()
-    started = time.perf_counter()
-    output = method.run(Counted(model, work), observations, run.rng("filter"))
-    elapsed = time.perf_counter() - started
+    with Stopwatch() as stopwatch:
+        output = method.run(Counted(model, work), observations, run.rng("filter"))
     output = expect_output(output, states.shape, run.method)  # a user's method may return anything
     return {
         "rmse": rmse(output.means, states),
-        "ms_per_step": 1000.0 * elapsed / model.steps,
+        "ms_per_step": 1000.0 * stopwatch.wall / model.steps,
+        "cpu_ms_per_step": 1000.0 * stopwatch.cpu / model.steps,
         **work.record(model.steps),
         **filter_diagnostics(output),
     }

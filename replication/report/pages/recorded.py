@@ -43,6 +43,8 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
         "experiments": {name: {"runs": entries[name].runs, "stale": n, "universes": entries[name].universes,
                                "designed": designed.get(name, 0),
                                "minutes": entries[name].minutes, "cpu_minutes": round(entries[name].wall_s / 60, 1),
+                               "thread_cpu_minutes": entries[name].cpu_s and round(entries[name].cpu_s / 60, 1),
+                               "load_1m": entries[name].load_1m,
                                "before": _before(entries[name].before)} for name, n in stale.items()},
         "profile": profile,
     }

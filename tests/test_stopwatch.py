@@ -1,0 +1,35 @@
+"""The two clocks of a run: waiting accrues wall time only, working accrues both, and blocks add up."""
+
+import time
+
+from replication.record.manifest import _load, _summed
+from replication.stopwatch import Stopwatch, load_1m
+
+
+def test_a_thread_that_waits_spends_wall_time_but_no_cpu_time():
+    with Stopwatch() as stopwatch:
+        time.sleep(0.05)
+    assert stopwatch.wall >= 0.05
+    assert stopwatch.cpu < 0.5 * stopwatch.wall  # sleeping is not work, however loaded the machine
+
+
+def test_blocks_add_up_and_the_last_is_kept():
+    stopwatch, walls = Stopwatch(), []
+    for n in (10_000, 200_000):
+        with stopwatch:
+            sum(i * i for i in range(n))
+        walls.append(stopwatch.last_wall)
+    assert stopwatch.wall == sum(walls) and walls[1] > 0
+    assert stopwatch.cpu > 0
+
+
+def test_the_load_is_a_non_negative_number_where_the_system_says():
+    load = load_1m()
+    assert load is None or load >= 0
+
+
+def test_the_manifest_sums_cpu_time_and_takes_the_median_and_largest_load():
+    rows = [{"cpu_s": 1.25, "load_1m": 2.0}, {"cpu_s": 2.5, "load_1m": 0.5}, {"cpu_s": None, "load_1m": 7.0}, {}]
+    assert _summed(rows, "cpu_s") == 3.8  # 3.75 rounded to 0.1 s
+    assert _load(rows) == (2.0, 7.0)
+    assert _summed([{}], "cpu_s") is None and _load([{}]) is None
