@@ -18,7 +18,6 @@ import pytest
 from conftest import PROJECT_ROOT
 
 from replication.errors import ConfigError
-from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.published import load_published
 from replication.evidence.tables import TableKind
 from replication.record.manifest import Before, Manifest
@@ -33,7 +32,10 @@ from replication.runner.config import expand, experiment_at_scale
 from replication.runner.execute import execute
 from replication.runner.machine import Machine
 from replication.runner.store import Store
+from replication.runner.curves import CURVES, curve_table
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 UNGM = ("scale=paper", "experiment.runs.paper=2", "experiment.model.steps=10")
 # bis_pf's 3123 test at its full length, one run per method: the runs whose strip the modes table reads
 BALLS = ("scale=paper", "experiment.runs.paper=1", "experiment.model.sweep.scene=[exp1_3123]")
@@ -119,18 +121,19 @@ def test_only_the_series_a_table_reads_are_kept_and_its_table_is_the_stores(make
     from_record, from_store = Record(tmp_path / "record").load(runs), store.load(runs)
     spec = next(t for t in experiment["report"]["tables"] if t.get("kind") == "modes")
     published = load_published(str(PROJECT_ROOT.parent / "shared" / "reference" / "published_values.csv"))
-    built = [TableKind.of(spec, experiment, published).build(r).written() for r in (from_record, from_store)]
+    built = [TableKind.of(spec, experiment, published, FOOTAGE).build(r).written() for r in (from_record, from_store)]
     assert built[0].equals(built[1]) and len(built[0])
     curve = next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve")
     with pytest.raises(NothingToDraw, match="drawn from each run's per_frame, which these records do not hold"):
-        draw(from_record, curve, experiment, tmp_path / "curve.png")
+        draw(from_record, curve, experiment, tmp_path / "curve.png", footage=FOOTAGE)
     kept = Record(tmp_path / "record").curves("bis_pf")  # instead, the curve the figure draws
     curves = {f["name"] for f in experiment["report"]["figures"] if f["kind"] in CURVES}
     assert curve["name"] in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
-    table = curve_table(from_store, curve, experiment)
+    table = curve_table(from_store, curve, experiment, FOOTAGE)
     assert list(kept[curve["name"]].columns) == list(table.columns) and len(table) > 100
     assert np.allclose(kept[curve["name"]]["mean"], table["mean"], rtol=1e-6)  # single precision
-    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]]).exists()
+    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]],
+                footage=FOOTAGE).exists()
 
 
 def rewritten(path, column, values):
@@ -367,7 +370,7 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     from omegaconf import OmegaConf
 
     from replication.paths import CONF_DIR
-    from replication.report.pages.multiverse import write_multiverse_report
+    from replication.report.experiments import write_multiverse
     from replication.runner.multiverse import load
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
@@ -398,7 +401,7 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     for where, store_of in (("store", None),
                             ("record", lambda name, u: record.universe(multiverse.name, u.name))):
         cfg.reports = str(tmp_path / where)
-        pages.append(write_multiverse_report(cfg, multiverse, (), store_of).parent)
+        pages.append(write_multiverse(cfg, multiverse, (), store_of).parent)
     assert (pages[0] / "cases.csv").read_text() == (pages[1] / "cases.csv").read_text()
     assert {r.grade for r in verify([cfg], record, 4, cheapest=False, n_jobs=2, progress=False).runs} == {
         Grade.IDENTICAL}

@@ -18,6 +18,7 @@ import pandas as pd
 
 from replication.display import method_label
 from replication.errors import ConfigError
+from replication.evidence.footage import Footage
 from replication.evidence.named_conditions import as_mapping, holds, instead_of, written
 from replication.evidence.published import cells
 from replication.evidence.statistics import Estimate
@@ -174,16 +175,17 @@ class TableKind:
         super().__init_subclass__(**kwargs)
         TableKind.registry[cls.kind] = cls
 
-    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame):
-        self.spec, self.experiment, self.published = spec, experiment, published
+    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None):
+        self.spec, self.experiment, self.published, self.footage = spec, experiment, published, footage
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame) -> "TableKind":
-        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison)."""
+    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None) -> "TableKind":
+        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison);
+        ``footage``: the video the runs saw, for a kind that reads it (the caller's)."""
         name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
         if name not in cls.registry:
             raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
-        return cls.registry[name](spec, experiment, published)
+        return cls.registry[name](spec, experiment, published, footage)
 
     def build(self, records: pd.DataFrame) -> Table:
         raise NotImplementedError
