@@ -233,7 +233,7 @@ def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypa
                      tmp_path / "f.png", footage=FOOTAGE)
     no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0], "strip": [None]}))
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):  # no run on the 3123 scene
-        tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
+        tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png", FOOTAGE)
     with pytest.raises(NothingToDraw, match="drawn from each run's strip, per_frame, which these records do not"):
         figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png", footage=FOOTAGE)
     seen = []

@@ -111,8 +111,9 @@ def main(argv: list[str]) -> None:
     index = write_index(reports, cfg.published_values)
     templates = resolve(cfg.findings) / "templates"
     if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
-        try:  # rendered from the index's claims.csv and summary.csv, then linked from it
-            for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
+        try:  # rendered from the summaries the index read, then linked from it
+            for page in write_html(render_findings(Drawn(reports, cfg.published_values), templates),
+                                   reports / "findings"):
                 print(f"findings: {page}")
             index = write_index(reports, cfg.published_values)
         except LookupError as error:
@@ -180,7 +181,7 @@ def findings(argv: list[str]) -> None:
     record, out = resolve(settings["record"]), resolve(settings["findings"])
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
-    drawn = Drawn(resolve(settings["reports"]) / PAGES)
+    drawn = Drawn(resolve(settings["reports"]) / PAGES, settings["published_values"])
     rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
     if drawn_pages(record, argv) is None:  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
