@@ -7,4 +7,5 @@ from replication.evidence.tables.table import (
     KEYS, CellResult, Row, Table, TableKind, cell_value, interval, match, matched, number, pair,
 )
 
-__all__ = ["KEYS", "CellResult", "Row", "Table", "TableKind", "cell_value", "interval", "match", "matched", "number", "pair"]
+__all__ = ["KEYS", "CellResult", "Row", "Table", "TableKind", "cell_value", "interval", "match", "matched", "number",
+           "pair"]

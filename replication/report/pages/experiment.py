@@ -31,10 +31,11 @@ SHOWN = 12  # of the differences a user's request makes, those the page lists (t
 
 @dataclass(frozen=True)
 class Shown:
-    """What the page shows beside the judgement, from the caller that read the runs (:mod:`replication.report.experiments`):
-    the folder, the published values judged against, the files written beside the page (the runs' tidy tables, the
-    toolkits' results folders), what each scene is, the curve tables kept in place of the runs' series (the
-    record's), the command that made the runs and the video they saw (:class:`~replication.evidence.footage.Footage`)."""
+    """What the page shows beside the judgement, from the caller that read the runs
+    (:mod:`replication.report.experiments`): the folder, the published values judged against, the files written
+    beside the page (the runs' tidy tables, the toolkits' results folders), what each scene is, the curve tables
+    kept in place of the runs' series (the record's), the command that made the runs and the video they saw
+    (:class:`~replication.evidence.footage.Footage`)."""
 
     out: Path
     published: pd.DataFrame
