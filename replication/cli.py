@@ -192,14 +192,14 @@ def run_experiment(cfg: DictConfig) -> None:
         stored = len(computed) - done
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
               + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
-        from replication.report.pages.experiment import write_experiment_report
+        from replication.report.experiments import write_experiment
         from replication.report.pages.index import write_index
         from hydra.core.hydra_config import HydraConfig
 
         from replication.runner.results import Results
 
         results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
-        written = write_experiment_report(cfg, results)
+        written = write_experiment(cfg, results)  # judged (evidence), then drawn (report)
         index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
         print(f"{cfg.experiment.name}: report in {written}; index in {index}")
         if results.own and cfg.experiment.get("also"):
@@ -284,11 +284,10 @@ def run_multiverse(cfg: DictConfig) -> None:
                       + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
         from hydra.core.hydra_config import HydraConfig
 
+        from replication.report.experiments import write_multiverse
         from replication.report.pages.index import write_index
-        from replication.report.pages.multiverse import write_multiverse_report
 
-        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task),
-                                          reader(recorded, layers))
+        written = write_multiverse(cfg, multiverse, tuple(HydraConfig.get().overrides.task), reader(recorded, layers))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'

@@ -15,7 +15,7 @@ from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.robustness import Pairing
 from replication.evidence.schema import Summary
 from replication.evidence.statistics import Estimate
-from replication.report.pages.multiverse import write_multiverse_report
+from replication.report.experiments import write_multiverse
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
@@ -108,7 +108,7 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
         runs = multiverse.runs_of(name)
         assert execute(runs, Store(tmp_path / "store", name), n_jobs=1, backend="threading", progress=False) \
             == len(runs)
-    page = write_multiverse_report(cfg, multiverse)
+    page = write_multiverse(cfg, multiverse)
     claim = Summary.read(page.parent / "summary.json").multiverse["hspf.ungm"]
     readings = [r.name for p in load_papers() for c in p.claims if c.id == "hspf.ungm" for r in c.readings
                 if r.experiment in multiverse.experiments]  # the equal-cost ones on hspf_ungm_cost included

@@ -13,7 +13,9 @@ from replication.report.figures import ranking as ranking_figures
 from replication.evidence.claims import ClaimTest, Result
 from replication.evidence.ranking import held_out, rank, rankings
 from replication.evidence.tables import Table, TableKind
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 SEQUENCES = [f"s{i}" for i in range(6)]
 
 
@@ -143,7 +145,7 @@ def test_ranking_and_pairwise_tables_and_the_figure(tmp_path, keep_figures):
     assert [(order.index(a), order.index(b)) for a, b in zip(pairs.frame["A"], pairs.frame["B"])] == \
         [(0, 1), (0, 2), (1, 2)]
     drawn = keep_figures(ranking_figures)
-    figures.draw(records, {**spec, "title": "t"}, experiment, tmp_path / "r.png")
+    figures.draw(records, {**spec, "title": "t"}, experiment, tmp_path / "r.png", footage=FOOTAGE)
     title = drawn[0].axes[0].get_title(loc="left")
     assert "not reliable" in title and "6 sequences x 1 run(s)" in title
 

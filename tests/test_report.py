@@ -222,8 +222,8 @@ def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
 
 
 def test_scale_changes_lists_what_quick_changes_from_the_config():
-    from replication.report.pages.scale import scale_changes, scale_note
-    from replication.scales import at_scale
+    from replication.report.pages.scale import scale_note
+    from replication.scales import at_scale, scale_changes
 
     config = {"quick_frames": {"paper": None, "quick": 100},  # a YAML anchor, not a setting
               "runs": {"paper": 100, "quick": 10},
@@ -240,9 +240,9 @@ def test_the_quick_banner_of_a_users_own_sequences_lists_them_not_the_shipped_on
     not the six shipped sequences it replaced."""
     from conftest import PROJECT_ROOT
 
-    from replication.report.pages.scale import scale_changes
     from replication.runner.results import Results
     from replication.runner.store import Store
+    from replication.scales import scale_changes
     from replication.scenes.otb import OTB_ROOT
 
     girl = PROJECT_ROOT / OTB_ROOT / "Girl"

@@ -24,7 +24,6 @@ import pyarrow as pa
 from omegaconf import DictConfig
 
 from replication.errors import ConfigError
-from replication.evidence.curves import CURVES, curve_table
 from replication.evidence.tables import TableKind
 from replication.record.layer import SCALE, checked
 from replication.record.manifest import Entry, Manifest
@@ -33,6 +32,8 @@ from replication.record.runs import (
 )
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
+from replication.runner.curves import CURVES, curve_table
+from replication.runner.footage import SceneFootage
 from replication.runner.multiverse import load
 from replication.runner.store import CorruptRecord, Store
 
@@ -139,7 +140,7 @@ def _complete(name: str, missing: int, total: int) -> None:
 
 
 def write_curves(experiment: dict, store: Store, runs: list[Run], folder: Path) -> list[Path]:
-    """The table of each of the experiment's curve figures (:mod:`replication.evidence.curves`), from the
+    """The table of each of the experiment's curve figures (:mod:`replication.runner.curves`), from the
     runs' per-frame series in ``store`` (read only for an experiment with such a figure), as
     ``<folder>/<figure>.parquet`` (floats in single precision: drawn, not tested); the files written
     (those of figures no longer configured are removed)."""
@@ -148,7 +149,7 @@ def write_curves(experiment: dict, store: Store, runs: list[Run], folder: Path) 
     records = store.load(runs) if specs else pd.DataFrame()
     written = []
     for spec in specs if len(records) else []:
-        table = curve_table(records, spec, experiment)
+        table = curve_table(records, spec, experiment, SceneFootage())
         if len(table):
             table = table.astype({c: "float32" for c in table if table[c].dtype == "float64"})
             written.append(folder / f"{spec['name']}.parquet")

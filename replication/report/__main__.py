@@ -36,9 +36,8 @@ from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
-from replication.report.pages.experiment import write_experiment_report
+from replication.report.experiments import write_experiment, write_multiverse
 from replication.report.pages.index import write_index
-from replication.report.pages.multiverse import write_multiverse_report
 from replication.report.pages.recorded import STATUS, write_status
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
@@ -112,8 +111,9 @@ def main(argv: list[str]) -> None:
     index = write_index(reports, cfg.published_values)
     templates = resolve(cfg.findings) / "templates"
     if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
-        try:  # rendered from the index's claims.csv and summary.csv, then linked from it
-            for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
+        try:  # rendered from the summaries the index read, then linked from it
+            for page in write_html(render_findings(Drawn(reports, cfg.published_values), templates),
+                                   reports / "findings"):
                 print(f"findings: {page}")
             index = write_index(reports, cfg.published_values)
         except LookupError as error:
@@ -149,23 +149,23 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
         configure(cfg.inference)
         if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
             multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
-            page = write_multiverse_report(cfg, multiverse, tuple(overrides),
-                                           lambda name, u: record.universe(multiverse.name, u.name))
+            page = write_multiverse(cfg, multiverse, tuple(overrides),
+                                    lambda name, u: record.universe(multiverse.name, u.name))
             return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
                                    for u in multiverse.universes for e in multiverse.experiments), \
                 len(multiverse.universes)
         if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs (at paper scale,
             multiverse = load_multiverse(cfg)  # the record's beneath them, as the run read them)
-            return name, write_multiverse_report(cfg, multiverse, tuple(overrides),
-                                                 reader(*universes_beneath(cfg, multiverse))), None, 0
+            return name, write_multiverse(cfg, multiverse, tuple(overrides),
+                                          reader(*universes_beneath(cfg, multiverse))), None, 0
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
-            return name, write_experiment_report(cfg, results), len(store.stale(results.runs)), 0
+            return name, write_experiment(cfg, results), len(store.stale(results.runs)), 0
         runs = expand(cfg)
         held = beneath(cfg, runs, Store(resolve(cfg.store), name))  # at paper scale, as the run read them
         results = Results.of(cfg, runs, held, tuple(overrides), held.curves)
-        return name, write_experiment_report(cfg, results), None, 0
+        return name, write_experiment(cfg, results), None, 0
 
 
 def findings(argv: list[str]) -> None:
@@ -181,7 +181,7 @@ def findings(argv: list[str]) -> None:
     record, out = resolve(settings["record"]), resolve(settings["findings"])
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
-    drawn = Drawn(resolve(settings["reports"]) / PAGES)
+    drawn = Drawn(resolve(settings["reports"]) / PAGES, settings["published_values"])
     rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
     if drawn_pages(record, argv) is None:  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
@@ -258,7 +258,7 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
                                       report_folder(resolve(cfg.reports), results.name, cfg.scale) / "sweeps",
                                       missing, command)
-            write_experiment_report(cfg, results)  # now linking the sweep
+            write_experiment(cfg, results)  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])
     for line in missing:

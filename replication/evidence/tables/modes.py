@@ -9,13 +9,14 @@ counts as two-mode when at least ``mass`` of the marginal lies within
 hypotheses are more than 2 ``width`` apart (before that they are one mode).
 A run keeps both modes when most of those frames do; a method does when
 most of its runs do (the table kind :class:`Modes`).
-The hypotheses come from the video each run saw (its ``scene_seed``).
+The hypotheses come from the video each run saw (its ``scene_seed``), read through the caller's
+:class:`~replication.evidence.footage.Footage`.
 """
 
 import numpy as np
 import pandas as pd
 
-from replication.evidence.aggregate import sequence_seen
+from replication.evidence.footage import Footage
 from replication.evidence.statistics import proportion
 from replication.evidence.tables.table import Table, TableKind, match
 from replication.evidence.verdict import judge_band
@@ -33,14 +34,14 @@ def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, w
     return float(held.all(axis=1)[apart].mean())
 
 
-def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -> np.ndarray:
+def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict, footage: Footage) -> np.ndarray:
     """Per run of one (method, condition): the share of the window's frames whose marginal of the hidden
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
     first, last = spec["window"]
     width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
     shares = []
     for index, run in group.iterrows():
-        sequence = sequence_seen(experiment, group.loc[[index]])
+        sequence = footage.seen(experiment, group.loc[[index]])
         axis = "xy".index(run["strip"]["axis"])
         truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
         hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
@@ -61,7 +62,7 @@ class Modes(TableKind):
         stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
         rows, entries = [], []
         for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
-            shares = runs_keeping_both_modes(group, self.spec, self.experiment)
+            shares = runs_keeping_both_modes(group, self.spec, self.experiment, self.footage)
             keeping = int((shares > 0.5).sum())
             estimate = proportion(keeping, len(shares))
             hit = match(theirs, method, group.iloc[0], self.spec)

@@ -9,6 +9,7 @@ Add a kind by subclassing :class:`TableKind` in a module of this package with a
 new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
 """
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -18,9 +19,10 @@ import pandas as pd
 
 from replication.display import method_label
 from replication.errors import ConfigError
+from replication.evidence.footage import Footage
 from replication.evidence.named_conditions import as_mapping, holds, instead_of, written
 from replication.evidence.published import cells
-from replication.evidence.statistics import Estimate
+from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import Outcome, Verdict
 
 # the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
@@ -61,15 +63,62 @@ class CellResult:
         return self.rating or ("" if self.estimate is None else str(self.estimate))
 
 
+def number(value) -> str:
+    """A number as a reader is told it: 4 significant digits, thousands whole; '' when not finite."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    if isinstance(value, str):
+        return value
+    return f"{value:,.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
+
+
+def interval(value, low, high, level=None) -> str:
+    """'value [low, high]', with the interval's level where given ('value [low, high] (90% CI)'), or the
+    value alone where the interval is not defined."""
+    if any(v is None or not math.isfinite(v) for v in (low, high)):
+        return number(value)
+    return f"{number(value)} [{number(low)}, {number(high)}]" + (f" ({said_level(level)})" if level else "")
+
+
+def cell_value(value):
+    """A table cell's value as a reader takes it: None where it is missing (NaN)."""
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+@dataclass(frozen=True)
+class Row:
+    """One row of a table as its CSV writes it: columns by name, numbers shown as :func:`number` shows them."""
+
+    where: str
+    values: dict
+
+    def __getitem__(self, column: str) -> str:
+        if column not in self.values:
+            raise LookupError(f"{self.where} has no column {column!r}; it has {', '.join(self.values)}")
+        return number(cell_value(self.values[column]))
+
+    def __getattr__(self, column: str) -> str:
+        if column.startswith("_"):
+            raise AttributeError(column)
+        return self[column]
+
+    @property
+    def estimate(self) -> str:
+        v = self.values
+        return interval(*(cell_value(v.get(k)) for k in ("ours", "ci_low", "ci_high")))
+
+
 @dataclass
 class Table:
     """Rows of ours (``frame``: numbers, and a Verdict per row where compared), the published cells
-    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), and a
-    line a reader must see beside it (``note``: a ranking that is not reliable)."""
+    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), a
+    line a reader must see beside it (``note``: a ranking that is not reliable), and where it was read from
+    (``where``: ``bis_pf/table2_error``, named in a reader's errors)."""
 
     frame: pd.DataFrame
     cells: list[CellResult] = field(default_factory=list)
     note: str = ""
+    where: str = ""
 
     @property
     def empty(self) -> bool:
@@ -88,9 +137,27 @@ class Table:
             shown["verdict"] = ["" if v is None else str(v) for v in self.frame["verdict"]]
         return shown
 
+    @property
+    def rows(self) -> list[Row]:
+        """Its rows as :meth:`written` writes them."""
+        return [Row(f"{self.where} row {i}", row) for i, row in enumerate(self.written().to_dict("records"))]
+
+    def at(self, **match) -> Row:
+        """The one row (as :meth:`written` writes it) whose columns equal ``match``."""
+        picked = self.written()
+        for column, value in match.items():
+            if column not in picked:
+                raise LookupError(f"{self.where} has no column {column!r}")
+            picked = picked[picked[column].astype(str) == str(value)]
+        where = f"{self.where} at {', '.join(f'{k}={v}' for k, v in match.items())}"
+        if len(picked) != 1:
+            raise LookupError(f"{where}: {len(picked)} rows, not one")
+        return Row(where, picked.iloc[0].to_dict())
+
     @classmethod
-    def read(cls, frame: pd.DataFrame) -> "Table":
-        """A table back from the CSV :meth:`written` made (the PDF is drawn from those files)."""
+    def read(cls, frame: pd.DataFrame, where: str = "") -> "Table":
+        """A table back from the CSV :meth:`written` made, to print or quote (the PDF, the findings), never to
+        decide: the verdicts are the summary's."""
         frame = frame.copy()
         if {"ours", "ci_low", "ci_high", "runs", "interval"} <= set(frame.columns):
             frame["estimate"] = [Estimate(*row[:4], "" if pd.isna(row[4]) else row[4]) for row in
@@ -101,7 +168,7 @@ class Table:
         for column in [c for c in frame.columns if {f"{c}_low", f"{c}_high"} <= set(frame.columns)]:
             frame[column] = [Estimate(v, lo, hi, n, "") for v, lo, hi, n in
                              zip(frame[column], frame.pop(f"{column}_low"), frame.pop(f"{column}_high"), frame["runs"])]
-        return cls(frame)
+        return cls(frame, where=where)
 
     def written(self) -> pd.DataFrame:
         """The frame for a CSV: numbers as numbers (a metric's interval in its ``_low`` and ``_high``
@@ -174,16 +241,17 @@ class TableKind:
         super().__init_subclass__(**kwargs)
         TableKind.registry[cls.kind] = cls
 
-    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame):
-        self.spec, self.experiment, self.published = spec, experiment, published
+    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None):
+        self.spec, self.experiment, self.published, self.footage = spec, experiment, published, footage
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame) -> "TableKind":
-        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison)."""
+    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None) -> "TableKind":
+        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison);
+        ``footage``: the video the runs saw, for a kind that reads it (the caller's)."""
         name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
         if name not in cls.registry:
             raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
-        return cls.registry[name](spec, experiment, published)
+        return cls.registry[name](spec, experiment, published, footage)
 
     def build(self, records: pd.DataFrame) -> Table:
         raise NotImplementedError

@@ -1,38 +1,45 @@
 """A figure kind: a function of (records, spec, experiment, path) registered under the name a spec's ``kind:``
-gives it, with the per-frame series of a run it reads, and :func:`draw`, the one way a page draws a figure."""
+gives it, with the per-frame series of a run it reads and whether it reads the video the runs saw (``footage``),
+and :func:`draw`, the one way a page draws a figure."""
 
 from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
 
-from replication.evidence.curves import CURVES, curve_table, figure_runs
+from replication.evidence.curves import figure_runs
+from replication.evidence.footage import Footage
 from replication.evidence.named_conditions import written
 from replication.evidence.published import COLUMNS
 from replication.report.figures.style import NothingToDraw
 
 KINDS: dict[str, Callable[..., Path]] = {}
 READS: dict[str, tuple[str, ...]] = {}  # kind -> the record columns of per-frame series it draws from
+FILMED: set[str] = set()  # the kinds drawn from the video the runs saw: given the footage
 
 
-def figure(kind: str, reads: tuple[str, ...] = ()) -> Callable:
+def figure(kind: str, reads: tuple[str, ...] = (), footage: bool = False) -> Callable:
     """Register the decorated function as the figure kind ``kind``, drawn from the series ``reads``
-    (``per_frame``, ``tracks``, ``strip``) of each run besides its metrics."""
+    (``per_frame``, ``tracks``, ``strip``) of each run besides its metrics, and with ``footage`` from the video
+    the runs saw (its ``footage=`` argument: a :class:`~replication.evidence.footage.Footage`)."""
     def register(draw_kind: Callable[..., Path]) -> Callable[..., Path]:
         KINDS[kind], READS[kind] = draw_kind, reads
+        if footage:
+            FILMED.add(kind)
         return draw_kind
     return register
 
 
 def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
-         published: pd.DataFrame | None = None, curve: pd.DataFrame | None = None) -> Path:
+         published: pd.DataFrame | None = None, curve: pd.DataFrame | None = None, *, footage: Footage) -> Path:
     """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
 
     A spec that names a ``paper_table`` gets the published values ``published``: the file the report was
     asked to judge against, passed down once (none: no paper values on the figure).
     A spec with ``conditions: [..]`` draws the runs of those conditions only.
-    A kind that draws a curve table (:data:`~replication.evidence.curves.CURVES`) draws ``curve`` where it
-    is given (the paper-scale record keeps the table, not the runs' series), else the table of ``records``.
+    A kind that draws a curve table (:data:`~replication.runner.curves.CURVES`) draws ``curve`` where it
+    is given (the paper-scale record keeps the table, not the runs' series), else the table ``footage`` computes
+    from ``records`` (:meth:`~replication.evidence.footage.Footage.curve`, below the report).
     """
     kind = spec["kind"]
     if kind not in KINDS:
@@ -46,13 +53,13 @@ def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
             # a scene the figure needs was not run (dropped by an override, say)
             shown = ", ".join(written(c) for c in spec["conditions"])
             raise NothingToDraw(f"figure {spec.get('name', kind)!r}: no runs at conditions {shown}")
-        if kind in CURVES:
-            curve = curve_table(records, spec, experiment)
-        elif "conditions" in spec:
+        curve = footage.curve(records, spec, experiment)
+        if curve is None and "conditions" in spec:
             records = records[figure_runs(records, spec)]
-    drawn = curve if kind in CURVES else records
+    drawn = records if curve is None else curve
+    given = {"footage": footage} if kind in FILMED else {}
     if "paper_table" not in spec:
-        return KINDS[kind](drawn, spec, experiment, path)
+        return KINDS[kind](drawn, spec, experiment, path, **given)
     if published is None:
         published = pd.DataFrame(columns=COLUMNS + ["number"])
-    return KINDS[kind](drawn, spec, experiment, path, published=published)
+    return KINDS[kind](drawn, spec, experiment, path, published=published, **given)

@@ -4,7 +4,9 @@ A run's record holds ``tracks``, the tracker's output as [frame, id, x, y, w, h]
 (MOT frame numbers from 1, 0-based top-left boxes, ids from 1), and ``first_frame``
 and ``last_frame``, the MOT frames it covered (inclusive); its condition names the
 scene, ``scene=<key>``, and the experiment's ``scenes[<key>]`` is ``{kind: mot, name:
-PETS09-S2L1, root: ...}`` (``root`` defaults to :data:`replication.scenes.mot.MOT_ROOT`).
+PETS09-S2L1, root: ...}`` (``root`` defaults to :data:`replication.scenes.mot.MOT_ROOT`).  The sequence, a
+run's tracks as rows and their CLEAR MOT matches come from the
+:class:`~replication.evidence.footage.Footage` the page is given (computed below the report).
 
 Every figure draws a track in the colour :func:`track_colour` gives its id, the same
 on every panel and figure; ground truth is a thin white outline, ignore regions a
@@ -12,7 +14,7 @@ dashed grey one.
 """
 
 import textwrap
-from functools import lru_cache
+from typing import Any
 from pathlib import Path
 
 import cv2
@@ -25,12 +27,10 @@ from matplotlib.patches import Rectangle
 from PIL import Image
 
 from replication import atomic
-from replication.metrics.mot import BOX, clear_mot_matches
 from replication.condition import PREFIX, values_of
 from replication.display import method_label
+from replication.evidence.footage import Footage
 from replication.report.figures.style import save
-from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
-from replication.tasks.mot import frame_table
 from replication.report.figures.base import figure
 
 # tab10 then Dark2, both without their grey (kept for the ignore regions) and without light tints (which
@@ -39,6 +39,7 @@ from replication.report.figures.base import figure
 ID_COLOURS = tuple(c for name in ("tab10", "Dark2") for c in plt.get_cmap(name).colors
                    if not np.allclose(c, c[0], atol=0.02))
 TRUTH, IGNORED = "white", "#b0b0b0"
+BOX = ["x", "y", "w", "h"]  # a box's columns in the truth, ignore and track tables (0-based top-left, size)
 OUTLINE = [patheffects.withStroke(linewidth=1.6, foreground="black")]  # an id's number, readable on any image
 
 
@@ -50,17 +51,6 @@ def track_colour(track_id: int) -> tuple[float, float, float]:
 def scene_key(runs: pd.DataFrame) -> str:
     """The scene (its key in the experiment's ``scenes``) of one condition's runs."""
     return values_of(runs, "scene").iloc[0]
-
-
-def mot_sequence(experiment: dict, scene_key: str) -> MotSequence:
-    """The MOT sequence of a scene of the experiment."""
-    scene = experiment["scenes"][scene_key]
-    return _load(scene["name"], scene.get("root", MOT_ROOT))
-
-
-@lru_cache(maxsize=4)
-def _load(name: str, root: str) -> MotSequence:
-    return load_mot(name, root)
 
 
 def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
@@ -89,7 +79,7 @@ def _boxes(ax, truth: pd.DataFrame, ignored: pd.DataFrame, tracks: pd.DataFrame,
                 path_effects=OUTLINE)
 
 
-def _panel(ax, sequence: MotSequence, frame: int, tracks: pd.DataFrame, fontsize: float = 5.5,
+def _panel(ax, sequence: Any, frame: int, tracks: pd.DataFrame, fontsize: float = 5.5,
            window: tuple[float, float, float, float] | None = None) -> None:
     """Frame ``frame`` of ``sequence`` with its boxes, the frame number as title; ``window`` (x0, y0, x1,
     y1 px) shows part of it."""
@@ -103,7 +93,7 @@ def _panel(ax, sequence: MotSequence, frame: int, tracks: pd.DataFrame, fontsize
     ax.set_title(f"frame {frame}", fontsize=7, pad=2)
 
 
-def _window(spec: dict, sequence: MotSequence, frames: list[int], tables: list[pd.DataFrame],
+def _window(spec: dict, sequence: Any, frames: list[int], tables: list[pd.DataFrame],
             margin: float = 40) -> tuple[float, float, float, float]:
     """The part of a scene's frames the snapshots show: the boxes of ``tables`` in ``frames`` with a
     ``margin`` (px) around them, or the whole frame with ``crop: false``."""
@@ -132,8 +122,8 @@ CAPTION = ("Coloured boxes: the tracker's output, one colour per track id (its n
            "white: ground truth; dashed grey: regions MOTChallenge ignores.")
 
 
-@figure("track_snapshots", reads=("tracks",))
-def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@figure("track_snapshots", reads=("tracks",), footage=True)
+def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
     """Frames of the real video with each method's output (its first run), one row per method and condition,
     one column per frame of ``spec.frames`` (``{<scene key>: [MOT frame numbers]}`` or one list for every
     scene; by default ``spec.columns``, 4, frames evenly spaced over the run).  The panels show the part of
@@ -142,10 +132,10 @@ def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     several = records["condition"].nunique() > 1
     for _, group in records.groupby("condition", sort=False):
         scene = scene_key(group)
-        sequence = mot_sequence(experiment, scene)
+        sequence = footage.mot_sequence(experiment, scene)
         runs = [run for _, run in _first_runs(group).iterrows()]
         frames = _snapshot_frames(spec, scene, runs[0], sequence.n_frames)
-        tracks = [frame_table(run) for run in runs]
+        tracks = [footage.tracks(run) for run in runs]
         window = _window(spec, sequence, frames, [sequence.truth, sequence.ignored, *tracks])
         for run, table in zip(runs, tracks):
             label = textwrap.fill(method_label(experiment, run["method"]), 24)
@@ -181,18 +171,17 @@ def _on(colour) -> str:
     return "black" if 0.299 * r + 0.587 * g + 0.114 * b > 0.5 else "white"
 
 
-def timeline_matches(sequence: MotSequence, run) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The truth of a run's frames and the CLEAR MOT matches of its tracks
-    (:func:`replication.metrics.mot.clear_mot_matches`, as the metrics count them)."""
+def timeline_matches(sequence: Any, run, footage: Footage) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The truth of a run's frames and the CLEAR MOT matches of its tracks (as the metrics count them:
+    :meth:`~replication.evidence.footage.Footage.matches`)."""
     first, last = int(run["first_frame"]), int(run["last_frame"])
     truth = _between(sequence.truth, first, last)
-    tracks, ignored = _between(frame_table(run), first, last), _between(sequence.ignored, first, last)
-    matches = clear_mot_matches(truth, tracks, ignored)
-    return truth, matches
+    tracks, ignored = _between(footage.tracks(run), first, last), _between(sequence.ignored, first, last)
+    return truth, footage.matches(truth, tracks, ignored)
 
 
-@figure("identity_timeline", reads=("tracks",))
-def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@figure("identity_timeline", reads=("tracks",), footage=True)
+def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
     """Which output track held which person, frame by frame: one panel per method (its first run) and
     condition, one lane per ground-truth id, a bar in the matched track's colour (its id written in it)
     where CLEAR MOT matches them (IoU >= 0.5, a match kept while it holds), a grey line where the person
@@ -200,9 +189,9 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
     panels = []
     for _, group in records.groupby("condition", sort=False):
         scene = scene_key(group)
-        sequence = mot_sequence(experiment, scene)
+        sequence = footage.mot_sequence(experiment, scene)
         for _, run in _first_runs(group).iterrows():
-            panels.append((scene, run, *timeline_matches(sequence, run)))
+            panels.append((scene, run, *timeline_matches(sequence, run, footage)))
     lanes = [max(truth["id"].nunique(), 1) for _, _, truth, _ in panels]
     fig, axes = plt.subplots(len(panels), 1, squeeze=False, height_ratios=lanes,
                              figsize=(10, 0.8 * len(panels) + 0.2 * sum(lanes)))
@@ -259,7 +248,7 @@ def _bgr(colour) -> tuple[int, int, int]:
     return tuple(round(255 * c) for c in to_rgb(colour)[::-1])
 
 
-def video_frame(sequence: MotSequence, frame: int, tracks: pd.DataFrame, width: int) -> np.ndarray:
+def video_frame(sequence: Any, frame: int, tracks: pd.DataFrame, width: int) -> np.ndarray:
     """Frame ``frame`` scaled to ``width`` px with its ignore regions (grey), truth (white) and output boxes
     (coloured by id, numbered), as RGB."""
     scale = width / sequence.size[0]
@@ -319,8 +308,8 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
     return path
 
 
-@figure("track_video", reads=("tracks",))
-def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@figure("track_video", reads=("tracks",), footage=True)
+def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
     """An animated GIF of one run, and a PNG poster as the figure: its first frame with an output box.
 
     The run is the first of ``spec.method`` (default: the first method) on ``spec.scene`` (a scene key;
@@ -330,11 +319,11 @@ def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path)
     ``link: <name>.gif`` in the figure's spec for the report page to link it.
     """
     run = _video_run(records, spec)
-    sequence = mot_sequence(experiment, run[f"{PREFIX}scene"])
+    sequence = footage.mot_sequence(experiment, run[f"{PREFIX}scene"])
     first, last = spec.get("frames", (int(run["first_frame"]), int(run["first_frame"]) + 99))
     first = max(int(first), int(run["first_frame"]), 1)
     last = min(int(last), int(run["last_frame"]), sequence.n_frames)
-    tracks = frame_table(run)
+    tracks = footage.tracks(run)
     animation = path.parent / spec.get("link", path.with_suffix(".gif").name)
     frames = [video_frame(sequence, k, tracks, spec.get("width", 384)) for k in range(first, last + 1)]
     write_gif(frames, animation, spec.get("fps", sequence.frame_rate))

@@ -8,14 +8,15 @@ import pandas as pd
 
 from replication import atomic
 from replication.condition import values_of
+from replication.evidence.footage import Footage
 from replication.report.figures import draw
 from replication.report.figures.style import NothingToDraw
 from replication.report.pages.render import render
 
 
-def write_sequence_pages(records: pd.DataFrame, experiment: dict, out: Path) -> list[dict]:
+def write_sequence_pages(records: pd.DataFrame, experiment: dict, out: Path, footage: Footage) -> list[dict]:
     """Write ``<out>/sequences/<scene>.html`` for each scene in ``records``; return one link per page
-    (``scene``, ``link``, ``what``: the sequence's name)."""
+    (``scene``, ``link``, ``what``: the sequence's name); ``footage``: the video the runs saw."""
     spec = experiment.get("report", {})
     names = spec.get("sequence_pages", [])
     by_name = {figure["name"]: figure for figure in spec.get("figures", [])}
@@ -33,7 +34,7 @@ def write_sequence_pages(records: pd.DataFrame, experiment: dict, out: Path) -> 
             if "scene" in figure:  # a one-scene figure (a video) on this scene
                 figure["scene"] = scene
             try:
-                draw(runs, figure, experiment, folder / f"{name}.png")
+                draw(runs, figure, experiment, folder / f"{name}.png", footage=footage)
             except NothingToDraw:
                 continue
             sections.append({"title": figure["title"], "figure": f"{scene}/{name}.png", "table": None,
