@@ -235,7 +235,7 @@ def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_lin
         load_own_papers(tmp_path)
     (tmp_path / "mine.yaml").write_text(head + "    claim: c\n    where: s\n    readings:\n"
                                         "      - {name: r, experiment: e, test: faster}\n")
-    with pytest.raises(ConfigError, match=r"mine.yaml: unknown claim test 'faster'; known: .*order"):
+    with pytest.raises(ConfigError, match=r"mine.yaml: claim mine.x, reading r: unknown claim test 'faster'; known claim tests: .*order"):
         load_own_papers(tmp_path)
 
 

@@ -20,9 +20,10 @@ first over several sequences, decided by its probability of ranking first) and
 import functools
 import itertools
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -42,20 +43,59 @@ from replication.evidence.published import cells as published_cells
 from replication.evidence.ranking import rankings, unreliable
 from replication.evidence.trends import dominance, log_log_slope
 from replication.condition import values_of
-from replication.evidence.tables import Table, match, pair
+from replication.evidence.tables import Table, match, pair, table_specs
 from replication.evidence.settings import INFERENCE
+from replication.kinds import Registry
+from replication.specs import Spec
 
 CLAIMS_DIR = CONF_DIR / "claims"
 EQUAL_N = "equal N"  # what a reading at the paper's own settings compares at
-NAMING = ("conditions", "condition", "chosen")  # the keys under which a reading names conditions
 WORK = "evaluations_per_step"  # the work counted beside a time (replication.smc.work)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ClaimSpec(Spec):
+    """What every reading's test names: the test, and the ``conditions`` it is checked at (each a mapping of
+    values, :func:`named`; none: each condition of the runs)."""
+
+    test: str
+    conditions: Any = None
+
+    @property
+    def naming(self) -> tuple:
+        """The options that name conditions, as written (:func:`named` reads them)."""
+        return (self.conditions,)
+
+    @property
+    def basis(self) -> str:
+        """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
+        they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
+        return ""
+
+
+CLAIM_TESTS: Registry[type["ClaimTest"]] = Registry("claim test")
+READING_KEYS = ("name", "experiment", "ours")  # a reading's own keys, beside its test's options
+
+
+def claim_spec(written: Mapping | ClaimSpec, where: str = "a claim's reading") -> ClaimSpec:
+    """A reading's test as its kind declares it (``test:``), checked (:meth:`~replication.specs.Spec.of`)."""
+    if isinstance(written, ClaimSpec):
+        return written
+    if not isinstance(written, Mapping):
+        raise ConfigError(f"{where}: a reading is a mapping of options, got {written!r}")
+    try:
+        made = CLAIM_TESTS[written.get("test")]
+    except ConfigError as error:
+        raise ConfigError(f"{where}: {error}") from None
+    return made.Spec.of({k: v for k, v in written.items() if k not in READING_KEYS}, f"{where} ({made.name})",
+                        READING_KEYS)
 
 
 @dataclass(frozen=True)
 class Reading:
     name: str
     experiment: str
-    test: dict
+    test: ClaimSpec
     ours: str = ""  # what this reading adds to the paper's words (a sequence it did not use, equal cost): never
     # the primary reading's
 
@@ -63,7 +103,7 @@ class Reading:
     def basis(self) -> str:
         """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
         they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
-        return ClaimTest.registry[self.test["test"]].basis(self.test) if self.test else ""
+        return self.test.basis
 
     @property
     def compared_at(self) -> str:
@@ -202,32 +242,28 @@ def _after_holm(check: Check, outcome: Outcome, adjusted: float, family: int) ->
 
 
 class ClaimTest:
-    """How a reading tests its claim; subclasses register by ``name`` and turn records into checks."""
+    """How a reading tests its claim; subclasses register by ``name``, declare their options (``Spec``) and
+    turn records into checks."""
 
     name: ClassVar[str]
+    Spec: ClassVar[type[ClaimSpec]] = ClaimSpec
     needs_runs: ClassVar[bool] = True  # False for a test of something computed, not run (point sets)
-    registry: ClassVar[dict[str, type["ClaimTest"]]] = {}
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        ClaimTest.registry[cls.name] = cls
+        CLAIM_TESTS.register(cls.name, cls)
 
-    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame | None = None):
+    def __init__(self, spec: ClaimSpec, experiment: dict, published: pd.DataFrame | None = None):
         self.spec, self.experiment, self.published = spec, experiment, published
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame | None = None) -> "ClaimTest":
-        if spec.get("test") not in cls.registry:
-            raise ValueError(f"unknown claim test {spec.get('test')!r}; known: {sorted(cls.registry)}")
-        return cls.registry[spec["test"]](spec, experiment, published)
+    def of(cls, spec: Mapping | ClaimSpec, experiment: dict, published: pd.DataFrame | None = None) -> "ClaimTest":
+        """The test a reading names, on its typed spec (a mapping is checked first: :func:`claim_spec`)."""
+        spec = claim_spec(spec)
+        return CLAIM_TESTS[spec.test](spec, experiment, published)
 
     def checks(self, records: pd.DataFrame, tables: dict[str, Table]) -> list[Check]:
         raise NotImplementedError
-
-    @classmethod
-    def basis(cls, spec: dict) -> str:
-        """The budget a reading by this test gives the methods in common ("": the paper's settings)."""
-        return ""
 
     @property
     def tables(self) -> list[str]:
@@ -258,11 +294,20 @@ class Order(ClaimTest):
 
     name = "order"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        metric: str
+        order: list
+        scale: float = 1.0
+        unit: str = ""
+        tolerance: float = 0.0
+        size: dict[str, Any] | None = None
+
     def checks(self, records, tables):
-        metric, scale = self.spec["metric"], self.spec.get("scale", 1.0)
+        metric, scale = self.spec.metric, self.spec.scale
         kind = quantity(metric)
-        unit = self.spec.get("unit", "")
-        groups = [_listed(g) for g in self.spec["order"]]
+        unit = self.spec.unit
+        groups = [_listed(g) for g in self.spec.order]
         found = []
         for condition in self.conditions(records):
             for better, worse in zip(groups, groups[1:]):
@@ -272,7 +317,7 @@ class Order(ClaimTest):
                     what = f"{a} - {b}" + (f" at {condition}" if condition else "")
                     if paired.empty:
                         continue
-                    allowed = self.spec.get("tolerance", 0.0) * abs(paired["baseline"].mean())
+                    allowed = self.spec.tolerance * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
                     paper = self.effect(a, b, records[records["condition"] == condition].iloc[0], len(paired))
                     verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
@@ -291,29 +336,30 @@ class Order(ClaimTest):
         cells as our table named by ``size.table`` matches them (a list: the first holding both; None where
         ``size`` names none, or a number is missing), with the runs behind them by :func:`~replication.evidence.original.paper_runs` (``runs``:
         ours): the table's ``paper_runs`` where the paper states them (a user's ``size.runs``)."""
-        size = self.spec.get("size")
+        size = self.spec.size
         if size and "quoted" in size:  # a user's claim quoting its own numbers ({method: number}), no table
             quoted = size["quoted"]
             if better not in quoted or worse not in quoted:
                 return None
-            behind = runs_behind(runs, size.get("runs"), [str(v) for v in quoted.values()], self.spec["metric"],
-                                 self.spec.get("scale", 1.0))
+            behind = runs_behind(runs, size.get("runs"), [str(v) for v in quoted.values()], self.spec.metric,
+                                 self.spec.scale)
             return Effect(float(quoted[better]), float(quoted[worse]), behind, size.get("kind", "difference"))
         if not size or self.published is None:
             return None
+        specs = {table.name: table for table in table_specs(self.experiment)}
         for name in _listed(size["table"]):  # the first of the named tables that holds both numbers here
-            table = next(t for t in self.experiment["report"]["tables"] if t["name"] == name)
-            theirs = published_cells(self.published, self.experiment["paper"], table["paper_table"],
-                                     table.get("paper_metric", table.get("metric")))
+            table = specs[name]
+            theirs = published_cells(self.published, self.experiment["paper"], table.paper_table,
+                                     table.published_metric)
             methods = size.get("methods", {})
             values = [match(theirs, str(methods.get(m, m)), ours, table)["number"] for m in (better, worse)]
             if all(len(v) == 1 and np.isfinite(v.iloc[0]) for v in values):
                 break
         else:
             return None
-        stated = table.get("paper_runs") if table.get("paper_runs_stated", True) else None
+        stated = table.paper_runs if table.paper_runs_stated else None
         printed = list(theirs.loc[theirs["number"].notna(), "value"])  # as printed: their precision
-        behind = runs_behind(runs, stated, printed, table["metric"], table.get("scale", 1.0))
+        behind = runs_behind(runs, stated, printed, table.metric, table.scale)
         return Effect(float(values[0].iloc[0]), float(values[1].iloc[0]), behind, size.get("kind", "difference"))
 
 
@@ -328,13 +374,22 @@ class EqualCost(ClaimTest):
 
     name = "equal_cost"
 
-    @classmethod
-    def basis(cls, spec):
-        return quantity(spec["cost"]).label or spec["cost"]
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        metric: str
+        cost: str
+        method: str | list[str]
+        baseline: str | list[str]
+        scale: float = 1.0
+        unit: str = ""
+
+        @property
+        def basis(self) -> str:
+            return quantity(self.cost).label or self.cost
 
     def checks(self, records, tables):
-        metric, cost = self.spec["metric"], self.spec["cost"]
-        pairs = itertools.product(_listed(self.spec["method"]), _listed(self.spec["baseline"]))
+        metric, cost = self.spec.metric, self.spec.cost
+        pairs = itertools.product(_listed(self.spec.method), _listed(self.spec.baseline))
         return [check for method, baseline in pairs for check in self.pair(records, metric, cost, method, baseline)]
 
     def pair(self, records: pd.DataFrame, metric: str, cost: str, method: str, baseline: str) -> list[Check]:
@@ -349,7 +404,7 @@ class EqualCost(ClaimTest):
             spent = theirs.groupby("condition")[cost].agg(statistic).sort_values()
             budget = float(ours[cost].agg(statistic))
             at = f" at {condition}" if condition else ""
-            what = f"{method}{at} - {baseline} at equal {self.basis(self.spec)}"
+            what = f"{method}{at} - {baseline} at equal {self.spec.basis}"
             reaching = spent[spent >= budget]
             if reaching.empty:
                 why = f"no condition of {baseline} reaches the budget (at most {spent.max():.4g})"
@@ -359,11 +414,11 @@ class EqualCost(ClaimTest):
             paired = pair(records, metric, baseline, method, condition, baseline_condition=chosen)
             paired = paired[np.isfinite(paired[["baseline", "method"]]).all(axis=1)]  # both defined
             better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-            scale = self.spec.get("scale", 1.0)
+            scale = self.spec.scale
             verdict, difference = _order_check(better, worse, quantity(metric), scale, 0.0, None)
             per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
             spends = f"budget {budget:.4g}; {baseline} at {chosen} spends {spent[chosen]:.4g}"
-            found.append(Check(what, verdict, difference, self.spec.get("unit", ""), 0.0, per_run, spends,
+            found.append(Check(what, verdict, difference, self.spec.unit, 0.0, per_run, spends,
                                timed=quantity(cost).machine_dependent))  # the baseline's N is chosen by time
         return found
 
@@ -469,9 +524,13 @@ class Cells(ClaimTest):
 
     name = "cells"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        tables: str | list[str]
+
     @property
     def tables(self):
-        return _listed(self.spec["tables"])
+        return _listed(self.spec.tables)
 
     def checks(self, records, tables):
         found = []
@@ -494,8 +553,23 @@ class Threshold(ClaimTest):
 
     name = "threshold"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        method: str
+        metric: str
+        at_least: float | None = None
+        at_most: float | None = None
+        condition: Any = None
+        statistic: str = "mean"
+        machine: str = ""  # "this": a time measured on this machine is tested
+        unit: str = ""
+
+        @property
+        def naming(self) -> tuple:
+            return (self.conditions, self.condition)
+
     def checks(self, records, tables):
-        ours = records[records["method"] == self.spec["method"]]
+        ours = records[records["method"] == self.spec.method]
         labels = self.conditions(ours)
         return [check for label in labels
                 for check in self.at(ours[ours["condition"] == label], f" at {label}" if len(labels) > 1 else "")]
@@ -503,39 +577,39 @@ class Threshold(ClaimTest):
     def at(self, chosen: pd.DataFrame, where: str) -> list[Check]:
         """The check on the runs of one condition, ``chosen`` (``where``: the condition, said after the method)."""
         spec = self.spec
-        metric = spec["metric"]
+        metric = spec.metric
         chosen = chosen[np.isfinite(chosen[metric].astype(float))]
         if chosen.empty:
             return []
         kind = quantity(metric)
         values = chosen[metric].to_numpy(float)
-        bound, above = (spec["at_least"], True) if "at_least" in spec else (spec["at_most"], False)
-        if kind.machine_dependent and spec.get("machine") != "this":  # a time measured on another machine
+        bound, above = (spec.at_least, True) if spec.at_least is not None else (spec.at_most, False)
+        if kind.machine_dependent and spec.machine != "this":  # a time measured on another machine
             return [_elsewhere(spec, values, bound, chosen, where)]
         if kind.proportion:
             test = proportion_test(int(round(values.sum() / kind.high)), len(values), bound / kind.high)
             factor = kind.high
         else:
-            test = (sign_test if spec.get("statistic") == "median" else mean_test)(values, bound)
+            test = (sign_test if spec.statistic == "median" else mean_test)(values, bound)
             factor = 1.0
         shown = Estimate(float(test.value) * factor, float(test.low) * factor, float(test.high) * factor,
                          len(values), test.method, 1 - 2 * INFERENCE.alpha)
-        what = f"{spec['method']}{where} {spec.get('statistic', 'mean')} {metric} {'>=' if above else '<='} {bound:g}"
+        what = f"{spec.method}{where} {spec.statistic} {metric} {'>=' if above else '<='} {bound:g}"
         p_for, p_against = (test.p_above, test.p_below) if above else (test.p_below, test.p_above)
         verdict = too_few(len(values)) or _threshold_verdict(_finite(p_for), _finite(p_against))
-        return [Check(what, verdict, shown, spec.get("unit", ""), float(bound),
+        return [Check(what, verdict, shown, spec.unit, float(bound),
                       dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound),
                       timed=kind.machine_dependent)]
 
 
-def _elsewhere(spec: dict, values: np.ndarray, bound: float, chosen: pd.DataFrame, where: str = "") -> Check:
+def _elsewhere(spec: "Threshold.Spec", values: np.ndarray, bound: float, chosen: pd.DataFrame, where: str = "") -> Check:
     """A bound on a time or frame rate that the paper measured on its own machine: not testable here
     (docs/statistics.md, "Times"), with our median over theirs shown (``where``: the condition, as a
     threshold's check says it)."""
     ours = float(np.median(values))
-    what = f"{spec['method']}{where} median {spec['metric']} against the paper's {bound:g} (its machine)"
+    what = f"{spec.method}{where} median {spec.metric} against the paper's {bound:g} (its machine)"
     why = f"a time measured on another machine is not testable; ours / theirs = {ours / bound:.3g}"
-    return Check(what, Verdict(Outcome.NOT_TESTABLE, why), None, spec.get("unit", ""), float(bound),
+    return Check(what, Verdict(Outcome.NOT_TESTABLE, why), None, spec.unit, float(bound),
                  dict(zip(chosen["repetition"].astype(int), values)), paper=float(bound), timed=True)
 
 
@@ -563,8 +637,21 @@ class Best(ClaimTest):
 
     name = "best"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        """A method's ranking (:func:`_ranking`): among ``among`` (every method), over the ``sequences``
+        (values of ``over``; every one), in the ranking of ``group`` (a value of ``by``)."""
+
+        method: str
+        metric: str
+        among: list[str] | None = None
+        sequences: list[str] | None = None
+        over: str = "scene"
+        by: str | None = None
+        group: str = ""
+
     def checks(self, records, tables):
-        metric, method = self.spec["metric"], self.spec["method"]
+        metric, method = self.spec.metric, self.spec.method
         found = _ranking(records, self.spec)
         if found is None:
             return []
@@ -590,17 +677,17 @@ class Best(ClaimTest):
         return checks
 
 
-def _ranking(records: pd.DataFrame, spec: dict):
+def _ranking(records: pd.DataFrame, spec: "Best.Spec"):
     """The ranking a ``best`` or ``rank`` claim is about (None where its method is not ranked): the runs of its
     ``among`` methods (with ``method``) over its ``sequences`` (values of the variable ``over``), every one where
     unset, in the ranking of its ``group``."""
     keep = pd.Series(True, index=records.index)
-    if spec.get("among"):
-        keep &= records["method"].isin([spec["method"], *spec["among"]])
-    if spec.get("sequences"):
-        keep &= values_of(records, spec.get("over", "scene")).isin(spec["sequences"])
-    found = rankings(records[keep], spec).get(spec.get("group", ""))
-    return found if found is not None and spec["method"] in found.methods else None
+    if spec.among:
+        keep &= records["method"].isin([spec.method, *spec.among])
+    if spec.sequences:
+        keep &= values_of(records, spec.over).isin(spec.sequences)
+    found = rankings(records[keep], spec.metric, spec.over, spec.by).get(spec.group)
+    return found if found is not None and spec.method in found.methods else None
 
 
 class Rank(ClaimTest):
@@ -611,13 +698,17 @@ class Rank(ClaimTest):
 
     name = "rank"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(Best.Spec):
+        top: int
+
     def checks(self, records, tables):
-        method = self.spec["method"]
+        method = self.spec.method
         found = _ranking(records, self.spec)
         if found is None:
             return []
-        rank, top = found.rank(found.index(method)), self.spec["top"]
-        what = f"{method}'s rank in mean {self.spec['metric']} among {len(found.methods)} over {len(found.sequences)} sequences, at most {top}"
+        rank, top = found.rank(found.index(method)), self.spec.top
+        what = f"{method}'s rank in mean {self.spec.metric} among {len(found.methods)} over {len(found.sequences)} sequences, at most {top}"
         caveat = unreliable(found, self.experiment)
         if caveat:
             verdict = Verdict(Outcome.NOT_TESTABLE, caveat)
@@ -637,21 +728,28 @@ class Growth(ClaimTest):
 
     name = "growth"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        method: str
+        metric: str
+        x: str
+        at_most: float
+
     def checks(self, records, tables):
         spec = self.spec
-        runs = records[records["method"] == spec["method"]]
-        x = pd.to_numeric(values_of(runs, spec["x"]), errors="coerce").to_numpy(float)
-        values = runs[spec["metric"]].to_numpy(float)
+        runs = records[records["method"] == spec.method]
+        x = pd.to_numeric(values_of(runs, spec.x), errors="coerce").to_numpy(float)
+        values = runs[spec.metric].to_numpy(float)
         kept = np.isfinite(x) & np.isfinite(values) & (x > 0) & (values > 0)
         if kept.sum() < INFERENCE.min_runs:
-            return [Check(f"{spec['method']} {spec['metric']} against {spec['x']}", too_few(int(kept.sum())))]
-        slope = log_log_slope(x[kept], values[kept], spec["at_most"])
-        what = f"{spec['method']}: growth exponent of {spec['metric']} in {spec['x']} ({len(set(x[kept]))} values)"
-        verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec['x']}^{spec['at_most']:g}")
+            return [Check(f"{spec.method} {spec.metric} against {spec.x}", too_few(int(kept.sum())))]
+        slope = log_log_slope(x[kept], values[kept], spec.at_most)
+        what = f"{spec.method}: growth exponent of {spec.metric} in {spec.x} ({len(set(x[kept]))} values)"
+        verdict = _threshold_verdict(_finite(slope.p_below), _finite(slope.p_above), f"faster than {spec.x}^{spec.at_most:g}")
         shown = Estimate(float(slope.value), float(slope.low), float(slope.high), slope.points,
                          "least squares on logs, t", 1 - 2 * INFERENCE.growth_alpha)
-        return [Check(what, verdict, shown, reference=float(spec["at_most"]), paper=float(spec["at_most"]),
-                      timed=quantity(spec["metric"]).machine_dependent)]
+        return [Check(what, verdict, shown, reference=float(spec.at_most), paper=float(spec.at_most),
+                      timed=quantity(spec.metric).machine_dependent)]
 
 
 class Pareto(ClaimTest):
@@ -662,9 +760,19 @@ class Pareto(ClaimTest):
 
     name = "pareto"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        method: str
+        metrics: list[str]
+        chosen: Any = None
+
+        @property
+        def naming(self) -> tuple:
+            return (self.conditions, self.chosen)
+
     def checks(self, records, tables):
-        spec, metrics = self.spec, list(self.spec["metrics"])
-        runs = records[records["method"] == spec["method"]]
+        spec, metrics = self.spec, list(self.spec.metrics)
+        runs = records[records["method"] == spec.method]
         keyed = runs.set_index(["data_condition", "repetition"])
         labels = self.conditions(runs)  # the chosen one (each, where the mapping picks several)
         found = []
@@ -690,15 +798,22 @@ class Uniformity(ClaimTest):
     name = "uniformity"
     needs_runs = False
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(ClaimSpec):
+        set: str
+        than: str
+        dims: int | list[int]
+        n: int = 400
+        method: str = "CD"
+
     def checks(self, records, tables):
         spec = self.spec
-        table = discrepancy_table(n=spec.get("n", 400), dims=tuple(_listed(spec["dims"])),
-                                  method=spec.get("method", "CD"))
+        table = discrepancy_table(n=spec.n, dims=tuple(_listed(spec.dims)), method=spec.method)
         found = []
         for _, row in table.iterrows():
-            ours, other = row[spec["set"]], row[spec["than"]]
+            ours, other = row[spec.set], row[spec.than]
             outcome = Outcome.REPRODUCED if ours < other else Outcome.NOT_REPRODUCED
-            found.append(Check(f"{spec['set']} vs {spec['than']}, s = {int(row['s'])}",
+            found.append(Check(f"{spec.set} vs {spec.than}, s = {int(row['s'])}",
                                Verdict(outcome, f"{ours:.2e} vs {other:.2e}")))
         return found
 
@@ -716,8 +831,8 @@ def load_papers(directory: Path = CLAIMS_DIR) -> tuple[Paper, ...]:
 
 def load_own_papers(directory: Path) -> tuple[Paper, ...]:
     """A user's claims files (the ``claims_dir`` setting) in the papers' format, judged on the user's own
-    reports only; a folder without one, a file lacking a key or a reading naming an unknown test is one
-    :class:`~replication.errors.ConfigError` line naming the file."""
+    reports only; a folder without one, a file lacking a key or a reading naming an unknown test or option
+    is one :class:`~replication.errors.ConfigError` line naming the file."""
     paths = sorted(Path(directory).glob("*.yaml"))
     if not paths:
         raise ConfigError(f"claims_dir={directory}: no claims file (*.yaml) there")
@@ -728,23 +843,18 @@ def load_own_papers(directory: Path) -> tuple[Paper, ...]:
         except (KeyError, TypeError, AttributeError, yaml.YAMLError) as error:
             what = f"lacks the key {error}" if isinstance(error, KeyError) else f"is not in the claims format ({error})"
             raise ConfigError(f"{path} {what}; see conf/claims/*.yaml") from None
-        unknown = [r.test.get("test") for c in paper.claims for r in c.readings
-                   if r.test.get("test") not in ClaimTest.registry]
-        if unknown:
-            raise ConfigError(f"{path}: unknown claim test {unknown[0]!r}; known: {', '.join(sorted(ClaimTest.registry))}")
         papers.append((order, paper))
     return tuple(paper for _, paper in sorted(papers, key=lambda item: item[0]))
 
 
 def _paper(path: Path) -> tuple[int, Paper]:
-    """One claims file: its paper's ``order`` and the paper with its claims."""
+    """One claims file: its paper's ``order`` and the paper with its claims, each reading's test checked
+    against the options its kind declares (:func:`claim_spec`), in the file's name."""
     data = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     claims = tuple(
         Claim(id=c["id"], paper=data["paper"], text=c["claim"], quote=Quote(**c.get("quote", {"text": "", "english": ""})),
               where=c.get("where", ""), cells=c.get("cells") or {},
-              readings=tuple(Reading(r["name"], r["experiment"], {k: v for k, v in r.items()
-                                                                  if k not in ("name", "experiment", "ours")},
-                                     r.get("ours", ""))
+              readings=tuple(_reading(r, f"{path}: claim {c['id']}, reading {r['name']}")
                              for r in c.get("readings") or ()),
               note=c.get("note", ""), untestable=c.get("untestable", ""))
         for c in data["claims"]
@@ -755,12 +865,17 @@ def _paper(path: Path) -> tuple[int, Paper]:
     return data["order"], Paper(data["paper"], data["title"], data["authors"], data["venue"], claims, path)
 
 
-def named(spec: dict, where: str = "a claim's reading") -> list[dict]:
+def _reading(written: dict, where: str) -> Reading:
+    """One reading of a claims file: its name, experiment and test (:func:`claim_spec`)."""
+    return Reading(written["name"], written["experiment"], claim_spec(written, where), written.get("ours", ""))
+
+
+def named(spec: ClaimSpec, where: str = "a claim's reading") -> list[dict]:
     """The conditions a reading names (``conditions:``, a threshold's ``condition:``, a pareto's ``chosen:``),
     each a mapping of variables to values that picks every condition taking them
     (:mod:`~replication.evidence.named_conditions`): each condition picked is a check of its own, as each
     condition is where the reading names none."""
-    return [condition for key in NAMING for condition in as_mappings(spec.get(key), where)]
+    return [condition for value in spec.naming for condition in as_mappings(value, where)]
 
 
 def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[str, Table],

@@ -25,7 +25,8 @@ from replication.report.pages.scale import scale_changes, scale_note
 from replication.report.pages.sequences import write_sequence_pages
 from replication.scales import index_from, report_folder
 from replication.report.figures.style import NothingToDraw
-from replication.evidence.tables import TableKind
+from replication.evidence.figures import figure_specs
+from replication.evidence.tables import Compared, TableKind, table_specs
 from replication.scenes.factory import cached_sequence, scene_kind
 from replication.runner.results import Results
 from replication.runner.variant import SHOWN
@@ -38,34 +39,32 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     out = report_folder(resolve(cfg.reports), results.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     published = load_published(str(published_path(cfg.published_values)))
-    spec = experiment.get("report", {})
     tables, figures, built, left_out = [], [], {}, []
     files = results.write_tables(out)
     results_folders = [f"results/{folder}/" for layout, folder in LAYOUTS.items()  # real OTB runs, for the toolkits
                        if "per_frame" in records and write_results(runs, records, out / "results", layout)]
     if len(records):
-        for table_spec in spec.get("tables", []):
+        for table_spec in table_specs(experiment):
             table = TableKind.of(table_spec, experiment, published).build(records)
             if table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
                 continue
-            built[table_spec["name"]] = table
-            csv = f"{table_spec['name']}.csv"
+            built[table_spec.name] = table
+            csv = f"{table_spec.name}.csv"
             atomic.save(out / csv, lambda tmp: table.written().to_csv(tmp, index=False))
             html = html_table(table.shown())
-            atomic.write_text(out / f"{table_spec['name']}.html", html)
-            tables.append({"name": table_spec["name"], "title": table_spec["title"], "html": html, "csv": csv,
+            atomic.write_text(out / f"{table_spec.name}.html", html)
+            tables.append({"name": table_spec.name, "title": table_spec.title, "html": html, "csv": csv,
                            "note": table.note})
-        for figure_spec in spec.get("figures", []):
-            file = f"{figure_spec['name']}.png"
+        for figure_spec in figure_specs(experiment):
+            file = f"{figure_spec.name}.png"
             try:
-                draw(records, figure_spec, experiment, out / file, published, results.curves.get(figure_spec["name"]))
+                draw(records, figure_spec, experiment, out / file, published, results.curves.get(figure_spec.name))
             except NothingToDraw as reason:  # as a table none of whose conditions ran: left out, and said
                 left_out.append(str(reason))
                 continue
-            link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
-            beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
-            figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link,
-                            **beside})
+            link = {"link": figure_spec.linked} if figure_spec.linked else {}  # a file the figure wrote too
+            beside = {"beside": figure_spec.beside} if figure_spec.beside else {}  # under that table
+            figures.append({"name": figure_spec.name, "title": figure_spec.title, "file": file, **link, **beside})
     sequences = write_sequence_pages(records, experiment, out) if len(records) else []
     compared = tuple(cell for table in built.values() for cell in table.cells)
     matched = {cell.published_index for cell in compared}
@@ -74,7 +73,7 @@ def write_experiment_report(cfg: DictConfig, results: Results) -> Path:
     own = load_own_papers(resolve(cfg.claims_dir)) if results.own and cfg.get("claims_dir") else ()
     claims = evaluate(experiment["name"], experiment, records, built, published, own if results.own else None)
     changes = scale_changes(results.at_paper_scale, experiment)
-    paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
+    paper_tables = sorted({t for s in table_specs(experiment) if isinstance(s, Compared) for t in s.paper_tables})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=list(matched), errors="ignore")
     page = out / "index.html"
@@ -166,10 +165,6 @@ def _provenance(records: pd.DataFrame) -> list[dict]:
     return [{**dict(zip(columns, key)), "runs": len(group),
              "computed": f"{group['computed_at'].min()[:16]} to {group['computed_at'].max()[:16]} UTC"}
             for key, group in groups]
-
-
-def _as_list(value) -> list:
-    return [] if value is None else value if isinstance(value, list) else [value]
 
 
 def _versions() -> str:

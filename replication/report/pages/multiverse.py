@@ -30,7 +30,7 @@ from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.scales import index_from, report_folder
 from replication.report.figures.style import OUTCOME_COLOURS
-from replication.evidence.tables import TableKind
+from replication.evidence.tables import TableKind, table_specs
 from replication.runner.multiverse import Multiverse
 from replication.runner.store import Store
 
@@ -63,10 +63,10 @@ def _tables(name: str, experiment: dict, records: pd.DataFrame, claims: list[Cla
     """The tables the claims' ``cells`` readings on ``name`` judge, built from ``records`` (only those)."""
     wanted = {t for c in claims for r in c.readings if r.experiment == name
               for t in ClaimTest.of(r.test, experiment).tables}
-    specs = [s for s in experiment.get("report", {}).get("tables", []) if s["name"] in wanted]
+    specs = [s for s in table_specs(experiment) if s.name in wanted]
     if records.empty:
         return {}
-    return {s["name"]: TableKind.of(s, experiment, published).build(records) for s in specs}
+    return {s.name: TableKind.of(s, experiment, published).build(records) for s in specs}
 
 
 def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> None:
