@@ -18,7 +18,8 @@ import pytest
 from conftest import PROJECT_ROOT
 
 from replication.errors import ConfigError
-from replication.evidence.curves import CURVES, curve_table
+from replication.evidence.curves import curve_table
+from replication.evidence.figures import FIGURE_KINDS, figure_spec
 from replication.evidence.published import load_published
 from replication.evidence.tables import TableKind
 from replication.record.manifest import Before, Manifest
@@ -121,16 +122,16 @@ def test_only_the_series_a_table_reads_are_kept_and_its_table_is_the_stores(make
     published = load_published(str(PROJECT_ROOT.parent / "shared" / "reference" / "published_values.csv"))
     built = [TableKind.of(spec, experiment, published).build(r).written() for r in (from_record, from_store)]
     assert built[0].equals(built[1]) and len(built[0])
-    curve = next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve")
+    curve = figure_spec(next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve"))
     with pytest.raises(NothingToDraw, match="drawn from each run's per_frame, which these records do not hold"):
         draw(from_record, curve, experiment, tmp_path / "curve.png")
     kept = Record(tmp_path / "record").curves("bis_pf")  # instead, the curve the figure draws
-    curves = {f["name"] for f in experiment["report"]["figures"] if f["kind"] in CURVES}
-    assert curve["name"] in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
+    curves = {f["name"] for f in experiment["report"]["figures"] if FIGURE_KINDS[f["kind"]].curve is not None}
+    assert curve.name in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
     table = curve_table(from_store, curve, experiment)
-    assert list(kept[curve["name"]].columns) == list(table.columns) and len(table) > 100
-    assert np.allclose(kept[curve["name"]]["mean"], table["mean"], rtol=1e-6)  # single precision
-    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]]).exists()
+    assert list(kept[curve.name].columns) == list(table.columns) and len(table) > 100
+    assert np.allclose(kept[curve.name]["mean"], table["mean"], rtol=1e-6)  # single precision
+    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve.name]).exists()
 
 
 def rewritten(path, column, values):
