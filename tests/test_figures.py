@@ -16,7 +16,8 @@ from replication.report.figures import metric as metric_figures, tracking as tra
 from replication.evidence.published import load_published
 from replication.evidence.curves import clip_diverged
 from replication.evidence.figures import AttributeMap, figure_spec
-from replication.report.figures.style import PALETTE, NothingToDraw, axis_label, method_look
+from replication.evidence.quantities import QUANTITIES, quantity
+from replication.report.figures.style import LABELS, PALETTE, NothingToDraw, axis_label, method_look
 
 PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
     "qmc,1,ungm,PF,rmse,N=100,9.2,,",
@@ -126,6 +127,11 @@ def test_axis_labels_read_in_words_with_the_raw_name_as_fallback():
     assert axis_label("ms_per_step") == "time per step (ms)"
     assert axis_label("correct_frames[iou>=0.5]") == "share of frames with IoU ≥ 0.5"
     assert axis_label("my_metric") == "my_metric" and axis_label("my_metric[x>1]") == "my_metric[x>1]"
+    # one vocabulary: a metric's words are the tables' and claims' (evidence.quantities), rules read there too
+    assert not set(LABELS) & set(QUANTITIES) and axis_label("mean_ess") == quantity("mean_ess").label
+    assert axis_label("tracked_to_end[cle<=20]") == quantity("tracked_to_end[cle<=20]").label == \
+        "runs tracked to the end (centre error ≤ 20 px)"
+    assert axis_label("N") == "number of particles N"
 
 
 def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_path):

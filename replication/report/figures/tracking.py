@@ -209,7 +209,7 @@ def attribute_map(records: pd.DataFrame, spec: AttributeMap, experiment: dict, p
     scores = attribute_scores(records, experiment)
     rows = list(dict.fromkeys(zip(scores["method"], scores["series"])))
     codes = list(dict.fromkeys(scores["attribute"]))
-    panels = [("precision20", "precision at 20 px"), ("success_auc", "success AUC")]
+    panels = [(metric, axis_label(metric)) for metric in ("precision20", "success_auc")]
     fig, axes = plt.subplots(len(panels), 1, figsize=(2.5 + 0.75 * max(len(codes), 4), 2 * (1.2 + 0.35 * len(rows))),
                              squeeze=False)
     if scores.empty:
