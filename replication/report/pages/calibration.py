@@ -14,6 +14,7 @@ more replications are asked for:
 
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -26,6 +27,7 @@ from omegaconf import OmegaConf  # noqa: E402
 from tqdm.auto import tqdm  # noqa: E402
 
 from replication import atomic  # noqa: E402
+from replication.arguments import read as read_arguments  # noqa: E402
 from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import detectable  # noqa: E402
   # noqa: E402
@@ -140,16 +142,17 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     return page
 
 
+@dataclass(frozen=True)
+class Options:
+    reports: str | None = None
+    replications: int = calibration.REPLICATIONS
+    force: bool = False
+
+
 def main(argv: list[str]) -> None:
-    options = dict(a.split("=", 1) for a in argv if "=" in a)
-    unknown = set(options) - {"reports", "replications", "force"}
-    if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.pages.calibration [reports=DIR] [replications=N] [force=true]",
-              file=sys.stderr)
-        raise SystemExit(2)
-    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    page = write_calibration(reports, int(options.get("replications", calibration.REPLICATIONS)),
-                             options.get("force", "false").lower() == "true")
+    options, _ = read_arguments(argv, Options, "python -m replication.report.pages.calibration")
+    reports = resolve(options.reports or OmegaConf.load(CONF_DIR / "config.yaml").reports)
+    page = write_calibration(reports, options.replications, options.force)
     print(f"calibration: {page}")
 
 
