@@ -12,7 +12,9 @@ from conftest import PROJECT_ROOT, typed
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
-from replication.evidence.claims import Check, ClaimTest, Reading, Result, claim_spec, load_papers
+from replication.evidence.checks import Check, Result
+from replication.evidence.claim_tests import ClaimTest, claim_spec
+from replication.evidence.claims import Reading, load_papers
 from replication.evidence.published import load_published
 from replication.evidence.settings import INFERENCE
 

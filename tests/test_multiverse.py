@@ -10,7 +10,9 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.claims import EQUAL_N, Check, Claim, Quote, Reading, Result, claim_spec, load_papers
+from replication.evidence.checks import Check, Result
+from replication.evidence.claim_tests import claim_spec
+from replication.evidence.claims import EQUAL_N, Claim, Quote, Reading, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.robustness import Pairing
 from replication.evidence.schema import Summary

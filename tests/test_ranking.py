@@ -10,7 +10,8 @@ from conftest import typed
 from replication.evidence.verdict import Outcome
 from replication.report import figures
 from replication.report.figures import ranking as ranking_figures
-from replication.evidence.claims import ClaimTest, Result
+from replication.evidence.checks import Result
+from replication.evidence.claim_tests import ClaimTest
 from replication.evidence.ranking import held_out, rank, rankings
 from replication.evidence.tables import Table, TableKind
 

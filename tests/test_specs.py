@@ -9,7 +9,8 @@ import yaml
 from hydra import compose, initialize_config_dir
 
 from replication.errors import ConfigError
-from replication.evidence.claims import CLAIM_TESTS, claim_spec, load_own_papers, load_papers
+from replication.evidence.claim_tests import CLAIM_TESTS, claim_spec
+from replication.evidence.claims import load_own_papers, load_papers
 from replication.evidence.figures import FIGURE_KINDS, MetricVsCondition, figure_spec
 from replication.evidence.tables import TABLE_KINDS, table_spec
 from replication.kinds import Registry

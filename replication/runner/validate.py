@@ -260,7 +260,8 @@ def tables_without_runs(cfg: DictConfig, runs: list[Run]) -> list[str]:
 def named_conditions(cfg: DictConfig) -> list[tuple[str, dict]]:
     """Each condition the experiment's report tables (``match:``) and figures (``conditions:``) name, and the
     claims' readings of it (the papers', and a user's own in ``claims_dir``), with where it is written."""
-    from replication.evidence.claims import load_own_papers, load_papers, named
+    from replication.evidence.claim_tests import named
+    from replication.evidence.claims import load_own_papers, load_papers
 
     name = cfg.experiment.name
     file = f"experiment/{name}.yaml"

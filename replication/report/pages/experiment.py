@@ -13,7 +13,8 @@ from omegaconf import DictConfig, OmegaConf
 
 import replication
 from replication import atomic
-from replication.evidence.claims import Result, evaluate, load_own_papers
+from replication.evidence.checks import Result
+from replication.evidence.claims import evaluate, load_own_papers
 from replication.evidence.schema import Summary
 from replication.evidence.settings import rules
 from replication.export import LAYOUTS, write_results

@@ -19,7 +19,8 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 from replication import atomic
-from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
+from replication.evidence.claim_tests import ClaimTest
+from replication.evidence.claims import Claim, evaluate, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import load_published, published_path
 from replication.evidence.schema import Summary
