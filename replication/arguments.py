@@ -27,7 +27,7 @@ def parse(argv: list[str], settings: type[T], command: str, handed: tuple[str, .
     values, passed = {}, []
     for arg in argv:
         key, equals, value = arg.partition("=")
-        if not equals and "*" not in handed:  # Hydra's own (~key) where it takes every other argument
+        if not equals and not (arg.startswith("~") and "*" in handed):  # Hydra's ~key: a deletion
             raise ConfigError(f"arguments are key=value; got {arg}")
         if key in fields and equals:
             values[key] = _typed(key, value, hints[key])

@@ -24,6 +24,8 @@ def test_settings_are_typed_with_their_defaults_and_the_rest_handed_on():
     assert handed == ["store=s", "experiment.runs.quick=2"]
     assert parse([], Settings, "cmd") == (Settings(), [])
     assert parse(["~experiment.report", "x=1"], Settings, "cmd", ("*",))[1] == ["~experiment.report", "x=1"]
+    with pytest.raises(ConfigError, match="arguments are key=value; got quick"):  # Hydra's own: ~key alone
+        parse(["quick"], Settings, "cmd", ("*",))
     assert names("gps_qmcpf,hspf") == ("gps_qmcpf", "hspf") and names("hspf") == ("hspf",)
 
 
