@@ -32,6 +32,7 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.arguments import names
 from replication.atomic import DiskFull
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
@@ -83,13 +84,13 @@ def experiment_file(name: str, argv: list[str]) -> Path:
 def chosen_experiments(argv: list[str]) -> dict[str, dict]:
     """The experiments the command line names (several in a multirun), each checked to exist and to
     parse, with its file as written; none for Hydra's own flags, which describe the app rather than run it."""
-    chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
+    chosen = [arg.partition("=")[2] for arg in argv if arg.startswith("experiment=")]
     if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
         return {}
     if not chosen:
         known = ", ".join(experiment_names(*config_dirs(argv)))
         raise ConfigError(f"name an experiment: pf-replicate experiment=<name>; known: {known}")
-    return {name: check_yaml(experiment_file(name, argv)) for name in chosen[-1].split(",")}
+    return {name: check_yaml(experiment_file(name, argv)) for name in names(chosen[-1])}
 
 
 def own_claims(argv: list[str]) -> list[str]:

@@ -15,7 +15,9 @@ from replication.report import figures
 from replication.report.figures import metric as metric_figures, tracking as tracking_figures
 from replication.evidence.published import load_published
 from replication.evidence.curves import clip_diverged
-from replication.report.figures.style import PALETTE, NothingToDraw, axis_label, method_look
+from replication.evidence.figures import AttributeMap, figure_spec
+from replication.evidence.quantities import QUANTITIES, quantity
+from replication.report.figures.style import LABELS, PALETTE, NothingToDraw, axis_label, method_look
 from replication.runner.footage import SceneFootage
 
 FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
@@ -110,10 +112,10 @@ def test_a_method_looks_the_same_on_figures_of_two_experiments(drawn, tmp_path):
     rng = np.random.default_rng(0)
     figures.draw(_scalar_records({("PF", f"N={n}"): list(rng.uniform(4, 5, 5)) for n in (100, 500)}
                                  | {("grid", ""): [4.0, 4.1]}),
-                 {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, ungm, tmp_path / "a.png", footage=FOOTAGE)
+                 {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, ungm, tmp_path / "a.png", footage=FOOTAGE)
     figures.draw(_tracking_records({"ISM-PF": rng.uniform(0, 5, (4, 30)).tolist(),
                                     "PF": rng.uniform(0, 5, (4, 30)).tolist()}),
-                 {"kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png", footage=FOOTAGE)
+                 {"name": "f", "kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png", footage=FOOTAGE)
     pf = [_lines(fig, "PF")[0] for fig in drawn]
     assert {to_hex(line.get_color()) for line in pf} == {method_look(ungm, "PF").colour.lower()} == {"#0072b2"}
     assert {line.get_marker() for line in pf} == {method_look(tracking, "PF").marker}
@@ -127,6 +129,11 @@ def test_axis_labels_read_in_words_with_the_raw_name_as_fallback():
     assert axis_label("ms_per_step") == "time per step (ms)"
     assert axis_label("correct_frames[iou>=0.5]") == "share of frames with IoU ≥ 0.5"
     assert axis_label("my_metric") == "my_metric" and axis_label("my_metric[x>1]") == "my_metric[x>1]"
+    # one vocabulary: a metric's words are the tables' and claims' (evidence.quantities), rules read there too
+    assert not set(LABELS) & set(QUANTITIES) and axis_label("mean_ess") == quantity("mean_ess").label
+    assert axis_label("tracked_to_end[cle<=20]") == quantity("tracked_to_end[cle<=20]").label == \
+        "runs tracked to the end (centre error ≤ 20 px)"
+    assert axis_label("N") == "number of particles N"
 
 
 def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_path):
@@ -134,7 +141,7 @@ def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_pat
     csv.write_text(PUBLISHED)
     experiment = {"paper": "qmc", "methods": {"PF": {"filter": "bootstrap"}, "NQMCPF": {"filter": "nqmcpf"}}}
     records = _scalar_records({(m, f"N={n}"): [4.0, 4.5, 5.0] for m in ("PF", "NQMCPF") for n in (100, 200, 500)})
-    spec = {"kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
+    spec = {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
             "paper_x": {"ungm": 200}}
     figures.draw(records, spec, experiment, tmp_path / "f.png", published=load_published(str(csv)), footage=FOOTAGE)
     paper = {to_hex(line.get_markeredgecolor()): (list(line.get_xdata()), list(line.get_ydata()))
@@ -178,7 +185,7 @@ def test_diverged_runs_are_clipped_and_counted_on_per_frame_curves(drawn, tmp_pa
     lost = rng.uniform(80, 120, (5, 40))  # a method that loses the target every run: not a divergence
     experiment = {"methods": {"PF": {"label": "PF"}, "MIL": {"label": "MIL"}}}
     figures.draw(_tracking_records({"PF": good.tolist(), "MIL": lost.tolist()}),
-                 {"kind": "per_frame_curve", "series": "cle"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
+                 {"name": "f", "kind": "per_frame_curve", "series": "cle"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
     pf, mil = _lines(drawn[0], "PF")[0], _lines(drawn[0], "MIL")[0]
     assert _label(drawn[0], "PF") == "PF (2 of 10 runs diverged, clipped)" and _label(drawn[0], "MIL") == "MIL"
     assert max(pf.get_ydata()) < max(mil.get_ydata()) * 10 / 2  # the blown-up run no longer dominates
@@ -187,7 +194,7 @@ def test_diverged_runs_are_clipped_and_counted_on_per_frame_curves(drawn, tmp_pa
 def test_diverged_runs_are_clipped_and_counted_on_metric_curves(drawn, tmp_path):
     experiment = {"methods": {"PF": {"label": "PF"}}}
     records = _scalar_records({("PF", "N=100"): [4.0, 5.0, 1e9, 4.5, 5.5], ("PF", "N=500"): [3.0, np.inf, 3.2, 3.1]})
-    figures.draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, experiment,
+    figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, experiment,
                  tmp_path / "m.png", footage=FOOTAGE)
     line = _lines(drawn[0], "PF")[0]
     assert _label(drawn[0], "PF") == "PF (2 of 9 runs diverged, clipped)"
@@ -229,16 +236,19 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
     records = typed(pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]}))
     with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
-        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": [{"scene": "c"}]}, {},
+        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N",
+                               "conditions": [{"scene": "c"}]}, {},
                      tmp_path / "f.png", footage=FOOTAGE)
     no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0], "strip": [None]}))
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):  # no run on the 3123 scene
-        tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png", FOOTAGE)
+        tracking_figures.mode_strip(no_strip, figure_spec({"name": "modes_3123", "kind": "mode_strip"}), {},
+                                    tmp_path / "m.png", footage=FOOTAGE)
     with pytest.raises(NothingToDraw, match="drawn from each run's strip, per_frame, which these records do not"):
         figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png", footage=FOOTAGE)
     seen = []
-    monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
-    figures.draw(records, {"kind": "probe", "conditions": [{"scene": "b"}]}, {}, tmp_path / "g.png", footage=FOOTAGE)
+    monkeypatch.setitem(figures.DRAWINGS, AttributeMap,
+                        lambda r, s, e, p, footage: seen.append(sorted(r["condition"])) or p)
+    figures.draw(records, {"name": "g", "kind": "attribute_map", "conditions": [{"scene": "b"}]}, {}, tmp_path / "g.png", footage=FOOTAGE)
     assert seen == [["scene=b"]]
 
 
@@ -285,7 +295,7 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
                                    "evaluations_per_step": e, "ms_per_step": s * (1 + 0.01 * r)}
                                   for m, c, e, s, values in rows for r, v in enumerate(values)]))
     experiment = {"methods": {}}
-    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
+    figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
     work, time = drawn[0].axes[:2]
     pf = next(line for line in work.get_lines() if line.get_label() == "PF")  # two budgets: a line and its band
     assert pf.get_xdata().tolist() == [100, 500] and pf.get_ydata() == pytest.approx([5.0, 4.0])  # ordered by cost
@@ -298,7 +308,7 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
     hspf = next(c for c in time.containers if c.get_label() == "HSPF").lines[0]
     assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the median time over runs
     with pytest.raises(ValueError, match="the runs have no"):
-        figures.draw(records, {"kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png", footage=FOOTAGE)
+        figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png", footage=FOOTAGE)
 
 
 def test_error_against_cost_paired_to_a_reference_draws_run_by_run_differences(keep_figures, tmp_path):
@@ -313,7 +323,7 @@ def test_error_against_cost_paired_to_a_reference_draws_run_by_run_differences(k
     records = typed(pd.DataFrame([{"method": m, "condition": c, "data_condition": "", "repetition": r, "rmse": v,
                                    "evaluations_per_step": e, "ms_per_step": 0.1 + e / 1e3}
                                   for m, c, e, values in rows for r, v in enumerate(values)]))
-    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse", "paired_to": "grid"}, {"methods": {}},
+    figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "rmse", "paired_to": "grid"}, {"methods": {}},
                  tmp_path / "p.png", footage=FOOTAGE)
     work = drawn[0].axes[0]
     (pf,) = [line for line in work.get_lines() if line.get_label() == "PF"]

@@ -95,7 +95,7 @@ def test_the_timeline_matches_are_motmetrics_matches_on_pets():
 @needs_mot
 def test_track_snapshots_draw_each_box_in_its_ids_colour(pets, drawn, tmp_path):
     _, records = pets
-    spec = {"kind": "track_snapshots", "frames": {"pets": [120, 180, 240, 900]}}  # 900: beyond the sequence
+    spec = {"name": "f", "kind": "track_snapshots", "frames": {"pets": [120, 180, 240, 900]}}  # 900: beyond the sequence
     draw(records, spec, EXPERIMENT, tmp_path / "snapshots.png", footage=FOOTAGE)
     axes = [ax for ax in drawn[0].axes if ax.images]
     assert len(axes) == 2 * 3  # methods x frames
@@ -118,9 +118,9 @@ def test_track_snapshots_draw_each_box_in_its_ids_colour(pets, drawn, tmp_path):
 
 @needs_mot
 @pytest.mark.parametrize("spec", [
-    {"kind": "track_snapshots"},  # frames evenly spaced over the run
-    {"kind": "identity_timeline"},
-    {"kind": "track_video", "method": "SORT", "frames": [101, 200], "link": "sort.gif"},
+    {"name": "f", "kind": "track_snapshots"},  # frames evenly spaced over the run
+    {"name": "f", "kind": "identity_timeline"},
+    {"name": "f", "kind": "track_video", "method": "SORT", "frames": [101, 200], "link": "sort.gif"},
 ])
 def test_each_kind_writes_a_file(pets, tmp_path, spec):
     _, records = pets
@@ -138,7 +138,7 @@ def test_each_kind_writes_a_file(pets, tmp_path, spec):
 @needs_mot
 def test_the_timeline_draws_a_lane_per_person_and_the_runs_switches(pets, drawn, tmp_path):
     sequence, records = pets
-    draw(records, {"kind": "identity_timeline"}, EXPERIMENT, tmp_path / "timeline.png", footage=FOOTAGE)
+    draw(records, {"name": "f", "kind": "identity_timeline"}, EXPERIMENT, tmp_path / "timeline.png", footage=FOOTAGE)
     axes = drawn[0].axes
     assert len(axes) == 2
     truth = sequence.truth[sequence.truth["frame"].between(FIRST, LAST)]

@@ -205,7 +205,7 @@ def test_a_new_filter_is_its_file_its_registration_and_its_yaml_entry(make_cfg, 
     page = write_experiment(cfg, results)
     table = (page.parent / "table1_rmse.csv").read_text()
     assert "\nSteady,N=50," in table and "\nPF (bootstrap),-," in table  # its key (no label:)
-    draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, results.experiment,
+    draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, results.experiment,
          tmp_path / "rmse.png", footage=SceneFootage())
     line = next(line for ax in drawn[-1].axes for c in ax.containers if c.get_label().startswith("Steady")
                 for line in c.lines[:1])

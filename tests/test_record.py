@@ -11,13 +11,13 @@ import sys
 from collections import Counter
 
 import numpy as np
-import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 from conftest import PROJECT_ROOT
 
 from replication.errors import ConfigError
+from replication.evidence.figures import FIGURE_KINDS, figure_spec
 from replication.evidence.published import load_published
 from replication.evidence.tables import TableKind
 from replication.record.manifest import Before, Manifest
@@ -123,16 +123,16 @@ def test_only_the_series_a_table_reads_are_kept_and_its_table_is_the_stores(make
     published = load_published(str(PROJECT_ROOT.parent / "shared" / "reference" / "published_values.csv"))
     built = [TableKind.of(spec, experiment, published, FOOTAGE).build(r).written() for r in (from_record, from_store)]
     assert built[0].equals(built[1]) and len(built[0])
-    curve = next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve")
+    curve = figure_spec(next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve"))
     with pytest.raises(NothingToDraw, match="drawn from each run's per_frame, which these records do not hold"):
         draw(from_record, curve, experiment, tmp_path / "curve.png", footage=FOOTAGE)
     kept = Record(tmp_path / "record").curves("bis_pf")  # instead, the curve the figure draws
-    curves = {f["name"] for f in experiment["report"]["figures"] if f["kind"] in CURVES}
-    assert curve["name"] in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
+    curves = {f["name"] for f in experiment["report"]["figures"] if FIGURE_KINDS[f["kind"]].curved}
+    assert curve.name in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
     table = curve_table(from_store, curve, experiment, FOOTAGE)
-    assert list(kept[curve["name"]].columns) == list(table.columns) and len(table) > 100
-    assert np.allclose(kept[curve["name"]]["mean"], table["mean"], rtol=1e-6)  # single precision
-    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]],
+    assert list(kept[curve.name].columns) == list(table.columns) and len(table) > 100
+    assert np.allclose(kept[curve.name]["mean"], table["mean"], rtol=1e-6)  # single precision
+    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve.name],
                 footage=FOOTAGE).exists()
 
 
@@ -439,3 +439,9 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
         "stored": len(larger_runs) - 1, "read from the record": 0, "to compute": 1}
     cfg.record = str(tmp_path / "record")
     assert multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2).endswith(": 0 runs to compute")
+
+
+def test_every_curved_figure_kind_has_its_curve_table_and_no_other_kind_does():
+    """A figure kind declares that it draws a curve table (``curved``); the table is computed below the report
+    (:data:`replication.runner.curves.CURVES`): the two lists name the same kinds."""
+    assert {name for name, kind in FIGURE_KINDS.items() if kind.curved} == set(CURVES)

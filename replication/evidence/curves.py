@@ -7,11 +7,11 @@ import pandas as pd
 from replication.evidence.named_conditions import as_mappings, matching
 
 
-def clip_level(spec: dict, typical: float) -> float | None:
+def clip_level(clip: float | None, typical: float) -> float | None:
     """Where a diverged run is cut: the figure's ``clip:``, else 10 times the typical magnitude given
     (none when that is 0 or unknown)."""
-    if spec.get("clip") is not None:
-        return float(spec["clip"])
+    if clip is not None:
+        return float(clip)
     level = 10 * abs(typical)
     return level if np.isfinite(level) and level > 0 else None
 
@@ -28,12 +28,12 @@ def clip_diverged(values, level: float | None) -> tuple[np.ndarray, np.ndarray]:
     return np.where(bad, edge, values), diverged
 
 
-def figure_conditions(spec: dict) -> list[dict]:
+def figure_conditions(spec) -> list[dict]:
     """The ``conditions`` figure ``spec`` is drawn at, each a mapping of values
     (:mod:`~replication.evidence.named_conditions`); none: every condition."""
-    return as_mappings(spec.get("conditions"), f"figure {spec.get('name', spec.get('kind'))!r}: conditions")
+    return as_mappings(spec.conditions, f"figure {spec.name!r}: conditions")
 
 
-def figure_runs(records: pd.DataFrame, spec: dict) -> pd.Series:
+def figure_runs(records: pd.DataFrame, spec) -> pd.Series:
     """Which of ``records`` figure ``spec`` draws, where it names ``conditions``: the runs at one of them."""
     return matching(records, *figure_conditions(spec))

@@ -31,8 +31,8 @@ class Footage(Protocol):
         """What each scene of the experiment is (``name``, ``kind``, ``what``), for its page; ``written``: the
         experiment as its YAML writes it (both scales' values)."""
 
-    def curve(self, records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame | None:
-        """The table a curve figure ``spec`` draws from ``records`` (:mod:`replication.runner.curves`); None
+    def curve(self, records: pd.DataFrame, spec, experiment: dict) -> pd.DataFrame | None:
+        """The table a curve figure ``spec`` (a typed figure spec) draws from ``records`` (:mod:`replication.runner.curves`); None
         for a figure kind that draws the runs themselves."""
 
     def mot_sequence(self, experiment: dict, scene_key: str) -> Any:

@@ -16,12 +16,13 @@ from typing import Protocol
 
 import pandas as pd
 
-from replication.evidence.claims import Claim, ClaimTest, Paper, evaluate, load_papers
+from replication.evidence.claim_tests import ClaimTest
+from replication.evidence.claims import Claim, Paper, evaluate, load_papers
 from replication.evidence.footage import Footage
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.published import cells
 from replication.evidence.schema import Summary
-from replication.evidence.tables import Table, TableKind
+from replication.evidence.tables import Compared, Table, TableKind, table_specs
 from replication.scales import scale_changes
 
 
@@ -47,19 +48,19 @@ def judge_experiment(name: str, experiment: dict, records: pd.DataFrame, *, scal
     reason), against ``published``; ``changes``: what the request changed in the shipped experiment;
     ``at_paper_scale``: the same config at the paper's scale (what the scale changes); ``papers``: whose
     claims (the five papers' unless given: a user's own, or none)."""
-    spec = experiment.get("report", {})
+    specs = table_specs(experiment)
     tables = {}
-    for table_spec in spec.get("tables", []) if len(records) else ():
+    for table_spec in specs if len(records) else ():
         table = TableKind.of(table_spec, experiment, published, footage).build(records)
         if not table.empty:  # none of the table's conditions was run (a narrowed sweep, say)
-            tables[table_spec["name"]] = table
+            tables[table_spec.name] = table
     compared = tuple(cell for table in tables.values() for cell in table.cells)
     claims = evaluate(experiment["name"], experiment, records, tables, published, papers)
-    paper_tables = sorted({str(t) for s in spec.get("tables", []) for t in _as_list(s.get("paper_table"))})
+    paper_tables = sorted({t for s in specs if isinstance(s, Compared) for t in s.paper_tables})
     unmatched = cells(published, experiment["paper"], paper_tables)
     unmatched = unmatched.drop(index=[cell.published_index for cell in compared], errors="ignore")
-    shown = tuple({"name": s["name"], "title": s["title"], "csv": f"{s['name']}.csv", "note": tables[s["name"]].note}
-                  for s in spec.get("tables", []) if s["name"] in tables)
+    shown = tuple({"name": s.name, "title": s.title, "csv": f"{s.name}.csv", "note": tables[s.name].note}
+                  for s in specs if s.name in tables)
     summary = Summary(name, experiment.get("title", experiment["name"]), experiment["paper"], scale, len(records),
                       n_runs, dict(failed), compared, claims,
                       tuple(scale_changes(at_paper_scale or experiment, experiment)), shown, own=tuple(changes))
@@ -121,11 +122,7 @@ def _claimed_tables(name: str, experiment: dict, records: pd.DataFrame, claims: 
     """The tables the claims' ``cells`` readings on ``name`` judge, built from ``records`` (only those)."""
     wanted = {t for c in claims for r in c.readings if r.experiment == name
               for t in ClaimTest.of(r.test, experiment).tables}
-    specs = [s for s in experiment.get("report", {}).get("tables", []) if s["name"] in wanted]
+    specs = [s for s in table_specs(experiment) if s.name in wanted]
     if records.empty:
         return {}
-    return {s["name"]: TableKind.of(s, experiment, published, footage).build(records) for s in specs}
-
-
-def _as_list(value) -> list:
-    return [] if value is None else value if isinstance(value, list) else [value]
+    return {s.name: TableKind.of(s, experiment, published, footage).build(records) for s in specs}

@@ -15,7 +15,8 @@ import pandas as pd
 
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
-from replication.evidence.claims import Check, Claim, Paper, Reading
+from replication.evidence.checks import Check
+from replication.evidence.claims import Claim, Paper, Reading
 from replication.evidence.schema import RobustnessResult, Summary
 from replication.evidence.summary import experiment_configs, summary_table
 

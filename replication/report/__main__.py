@@ -20,6 +20,7 @@ A bar counts the experiments drawn (``progress=false`` hides it).
 
 import shutil
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from hydra import compose, initialize_config_dir
@@ -27,6 +28,7 @@ from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
 from replication import atomic
+from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.settings import configure
@@ -46,48 +48,50 @@ from replication.runner.results import Results
 from replication.runner.store import Store
 from replication.scales import report_folder
 
-SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
 SCREENSHOT = "screenshot.png"
 PICTURE = "scorecard.png"  # the record's first page beside its findings (the README shows it)
 README_PATH = "README.md"  # whose part on the record (its size, what made it, what each part took) findings renders
-OPTIONS = ("sweep", "metric", "source")  # ours too: name=text
 SOURCES = ("store", "record")
+
+
+@dataclass(frozen=True)
+class Options:
+    """The command's own settings; every other argument is a setting of the config (Hydra's)."""
+
+    experiment: tuple[str, ...] | None = None  # every experiment by default
+    pdf: bool = True
+    screenshot: bool = False
+    sweep: str | None = None  # <key>=v1,v2,...: a multirun's sweep
+    metric: str | None = None  # the sweep's column
+    source: str = "store"  # or record
 
 
 def main(argv: list[str]) -> None:
     if {"--help", "-h"} & set(argv):
         print(__doc__.strip())
         return
-    chosen = [a.split("=", 1)[1].split(",") for a in argv if a.startswith("experiment=")]
-    names = chosen[-1] if chosen else experiment_names()
-    switches = dict(SWITCHES)
-    for arg in argv:
-        name, _, value = arg.partition("=")
-        if name in SWITCHES:
-            if value.lower() not in ("true", "false"):
-                fail(f"{name} must be true or false, got {value!r}")
-            switches[name] = value.lower() == "true"
-    options = {a.partition("=")[0]: a.partition("=")[2] for a in argv if a.partition("=")[0] in OPTIONS}
-    overrides = [a for a in argv if not a.startswith("experiment=") and a.partition("=")[0] not in (*SWITCHES, *OPTIONS)]
+    options, overrides = read(argv, Options, "report", handed=("*",))
+    chosen = options.experiment is not None
+    names = options.experiment if chosen else experiment_names()
     unknown = sorted(set(names) - set(experiment_names()))
     if unknown:
         fail(f"unknown experiment {unknown[0]!r}; known: {', '.join(experiment_names())}")
-    if "sweep" in options:
+    if options.sweep is not None:
         if len(names) != 1:
             fail("sweep= needs one experiment=<name>: the one the multirun ran")
-        return report_sweep(names[0], options["sweep"], options.get("metric"), overrides)
-    if "metric" in options:
+        return report_sweep(names[0], options.sweep, options.metric, overrides)
+    if options.metric is not None:
         fail("metric= only goes with sweep=")
-    source = options.get("source", "store")
+    source = options.source
     if source not in SOURCES:
         fail(f"source must be one of {', '.join(SOURCES)}, got {source!r}")
     if source == "record":
-        names, overrides = recorded_experiments(names, overrides, bool(chosen))
+        names, overrides = recorded_experiments(names, overrides, chosen)
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # the settings: workers, folders
         cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
     try:  # each experiment's pages on its own worker (the order of the output is the experiments')
         pages = Parallel(n_jobs=cfg.n_jobs, return_as="generator")(
-            delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+            delayed(draw)(name, overrides, source, chosen) for name in names)
         drawn = list(tqdm(pages, total=len(names), desc="pages", unit="experiment", disable=not cfg.progress,
                           mininterval=1.0))
     except ConfigError as error:
@@ -104,7 +108,7 @@ def main(argv: list[str]) -> None:
         held = resolve(cfg.record)
         drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", published_path(cfg.published_values)))
         print(f"status: {write_status(reports, Manifest.read(held), stale, designed, drawn_from, read_profile(held))}")
-    if switches["pdf"]:
+    if options.pdf:
         from replication.report.pdf import write_pdf
 
         print(f"pdf: {write_pdf(reports, cfg.published_values)}")
@@ -119,7 +123,7 @@ def main(argv: list[str]) -> None:
         except LookupError as error:
             print(f"findings: not drawn: {error}", file=sys.stderr)
     print(f"index: {index}")
-    if switches["screenshot"]:
+    if options.screenshot:
         from replication.report.pages.render import browser, open_in_browser
 
         if browser() is None:

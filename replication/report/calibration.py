@@ -15,6 +15,7 @@ more replications are asked for:
 
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -22,6 +23,7 @@ from omegaconf import OmegaConf
 from tqdm.auto import tqdm
 
 from replication import atomic
+from replication.arguments import read as read_arguments
 from replication.evidence import calibration
 from replication.evidence.settings import INFERENCE
 from replication.paths import CONF_DIR, resolve
@@ -64,16 +66,17 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
     return write_calibration_page(load_or_calibrate(reports, replications, force), reports)
 
 
+@dataclass(frozen=True)
+class Options:
+    reports: str | None = None
+    replications: int = calibration.REPLICATIONS
+    force: bool = False
+
+
 def main(argv: list[str]) -> None:
-    options = dict(a.split("=", 1) for a in argv if "=" in a)
-    unknown = set(options) - {"reports", "replications", "force"}
-    if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.calibration [reports=DIR] [replications=N] [force=true]",
-              file=sys.stderr)
-        raise SystemExit(2)
-    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    page = write_calibration(reports, int(options.get("replications", calibration.REPLICATIONS)),
-                             options.get("force", "false").lower() == "true")
+    options, _ = read_arguments(argv, Options, "python -m replication.report.calibration")
+    reports = resolve(options.reports or OmegaConf.load(CONF_DIR / "config.yaml").reports)
+    page = write_calibration(reports, options.replications, options.force)
     print(f"calibration: {page}")
 
 

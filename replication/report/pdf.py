@@ -13,6 +13,7 @@ import datetime
 import re
 import sys
 import textwrap
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
@@ -28,6 +29,7 @@ from matplotlib.patches import Rectangle  # noqa: E402
 
 import replication  # noqa: E402
 from replication import atomic  # noqa: E402
+from replication.arguments import read  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
@@ -398,18 +400,20 @@ def _outline(path: Path, marks: list[tuple[str, str | None, int]]) -> None:
     writer.write(str(path))
 
 
+@dataclass(frozen=True)
+class Options:
+    reports: str | None = None
+    published_values: str | None = None
+
+
 def main(argv: list[str]) -> None:
-    options = dict(a.split("=", 1) for a in argv if "=" in a)
-    unknown = set(options) - {"reports", "published_values"}
-    if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.pdf [reports=DIR] [published_values=CSV]", file=sys.stderr)
-        raise SystemExit(2)
+    options, _ = read(argv, Options, "python -m replication.report.pdf")
     from replication.report.pages.index import write_index
 
-    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    path = write_pdf(reports, options.get("published_values"))
+    reports = resolve(options.reports or OmegaConf.load(CONF_DIR / "config.yaml").reports)
+    path = write_pdf(reports, options.published_values)
     print(f"pdf: {path}")
-    print(f"index: {write_index(reports, options.get('published_values'))}")
+    print(f"index: {write_index(reports, options.published_values)}")
 
 
 if __name__ == "__main__":

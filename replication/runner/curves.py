@@ -1,54 +1,46 @@
 """Curves over frames and thresholds as tidy tables: what the report's curve figures draw, computed from
 the runs' per-frame series, and what the paper-scale record keeps in place of the series.
 
-Each is registered under the figure kind that draws it (:data:`CURVES`); it takes the runs (a records
-table with ``per_frame``), the figure's spec and the experiment, and gives one row per point of a line,
+Each is registered under the figure kind that draws it (:data:`CURVES`: the kinds whose
+:class:`~replication.evidence.figures.FigureSpec` is ``curved``); it takes the runs (a records table with
+``per_frame``), the figure's typed spec and the experiment, and gives one row per point of a line,
 in the order the lines are drawn (conditions, then methods, as the runs come).  :func:`curve_table` is
 the table of one figure spec.  A table that needs the video the runs saw (the image's size) reads it from
 the :class:`~replication.evidence.footage.Footage` given.  They live here, below the evidence and the report,
 since they compute with the metrics (compiled code): the caller hands the tables up to the figures.
 """
 
-from collections.abc import Callable
-
 import numpy as np
 import pandas as pd
 
 from replication.evidence.curves import clip_diverged, clip_level, figure_runs
+from replication.evidence.figures import FigureSpec
 from replication.evidence.footage import Footage
+from replication.kinds import Registry
 from replication.metrics import tracking as tm
 
-
-CURVES: dict[str, Callable[[pd.DataFrame, dict, dict, Footage], pd.DataFrame]] = {}  # figure kind -> its table
-
-
-def curve(kind: str) -> Callable:
-    """Register the decorated function as the table the figure kind ``kind`` draws."""
-    def register(table: Callable) -> Callable:
-        CURVES[kind] = table
-        return table
-    return register
+CURVES: Registry = Registry("curve table")  # a curved figure kind -> the table it draws
 
 
-def curve_table(records: pd.DataFrame, spec: dict, experiment: dict, footage: Footage) -> pd.DataFrame:
-    """The table figure ``spec`` (a kind in :data:`CURVES`) draws, from the runs of its ``conditions``
-    (all, if it names none); empty if none of them was run."""
-    if "conditions" in spec:
+def curve_table(records: pd.DataFrame, spec: FigureSpec, experiment: dict, footage: Footage) -> pd.DataFrame:
+    """The table figure ``spec`` (a curved kind) draws, from the runs of its ``conditions`` (all, if it names
+    none); empty if none of them was run."""
+    if spec.conditions is not None:
         records = records[figure_runs(records, spec)]
-    return CURVES[spec["kind"]](records, spec, experiment, footage) if len(records) else pd.DataFrame()
+    return CURVES[spec.kind](records, spec, experiment, footage) if len(records) else pd.DataFrame()
 
 
-@curve("per_frame_curve")
-def per_frame_band(records: pd.DataFrame, spec: dict, experiment: dict, footage: Footage) -> pd.DataFrame:
+@CURVES.register("per_frame_curve")
+def per_frame_band(records: pd.DataFrame, spec: FigureSpec, experiment: dict, footage: Footage) -> pd.DataFrame:
     """Per condition, method and frame, the mean and 10-90 % band over runs of the per-frame series
     ``spec.series`` (a run diverged beyond the condition's :func:`~replication.evidence.curves.clip_level` is
     clipped, and counted in ``diverged``); frames no run estimates and methods that do not record the series
     are left out."""
     rows = []
     for condition, group in records.groupby("condition", sort=False):
-        curves = _per_frame(group, spec["series"])
+        curves = _per_frame(group, spec.series)
         typical = max((np.nanmax(np.nanmedian(np.abs(v), axis=0)) for _, v in curves.values()), default=np.nan)
-        level = clip_level(spec, typical)
+        level = clip_level(spec.clip, typical)
         for method, (frames, values) in curves.items():
             values, diverged = clip_diverged(values, level)
             low, high = np.nanpercentile(values, [10, 90], axis=0)
@@ -59,8 +51,8 @@ def per_frame_band(records: pd.DataFrame, spec: dict, experiment: dict, footage:
         columns=["condition", "method", "frame", "mean", "low", "high", "runs", "diverged"])
 
 
-@curve("otb_curves")
-def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, footage: Footage) -> pd.DataFrame:
+@CURVES.register("otb_curves")
+def otb_curves(records: pd.DataFrame, spec: FigureSpec, experiment: dict, footage: Footage) -> pd.DataFrame:
     """OTB's one-pass precision and success curves per method: each the mean over runs of the run's curve
     (over the frames :func:`~replication.metrics.tracking.scored_frames` counts), with ``score`` the mean
     precision at 20 px or success AUC (the legend's number)."""
@@ -78,8 +70,8 @@ def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict, footage: Foo
     return pd.concat(rows, ignore_index=True)
 
 
-@curve("outside_curve")
-def outside_share(records: pd.DataFrame, spec: dict, experiment: dict, footage: Footage) -> pd.DataFrame:
+@CURVES.register("outside_curve")
+def outside_share(records: pd.DataFrame, spec: FigureSpec, experiment: dict, footage: Footage) -> pd.DataFrame:
     """Per method and frame, the share of estimated centres outside the image (the filter's own state),
     over runs and targets."""
     size = footage.seen(experiment, records).size

@@ -15,7 +15,7 @@ import pandas as pd
 from replication.evidence.aggregate import scene_of
 from replication.metrics.mot import clear_mot_matches
 from replication.metrics.multi import assignments
-from replication.runner.curves import CURVES, curve_table
+from replication.runner.curves import curve_table
 from replication.scenes.factory import OTB, cached_sequence, scene_kind
 from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
 from replication.scenes.otb import otb_attributes
@@ -47,7 +47,7 @@ class SceneFootage:
         return [_described(name, spec, written) for name, spec in experiment.get("scenes", {}).items()]
 
     def curve(self, records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame | None:
-        return curve_table(records, spec, experiment, self) if spec["kind"] in CURVES else None
+        return curve_table(records, spec, experiment, self) if spec.curved else None
 
     def mot_sequence(self, experiment: dict, scene_key: str) -> MotSequence:
         scene = experiment["scenes"][scene_key]

@@ -4,8 +4,9 @@ from replication.evidence.tables import (  # noqa: F401  (each registers its kin
     attributes, comparison, discrepancy, improvement, modes, ranking, rating, summary, tuning,
 )
 from replication.evidence.tables.table import (
-    KEYS, CellResult, Row, Table, TableKind, cell_value, interval, match, matched, number, pair,
+    KEYS, TABLE_KINDS, CellResult, Compared, Row, Table, TableKind, TableSpec, cell_value, interval, match, matched,
+    number, pair, table_spec, table_specs,
 )
 
-__all__ = ["KEYS", "CellResult", "Row", "Table", "TableKind", "cell_value", "interval", "match", "matched", "number",
-           "pair"]
+__all__ = ["KEYS", "TABLE_KINDS", "CellResult", "Compared", "Row", "Table", "TableKind", "TableSpec", "cell_value",
+           "interval", "match", "matched", "number", "pair", "table_spec", "table_specs"]

@@ -6,13 +6,15 @@ published cells each row was matched with (by :func:`match`, the one rule
 for that) and a :class:`~replication.evidence.verdict.Verdict`.
 
 Add a kind by subclassing :class:`TableKind` in a module of this package with a
-new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
+new ``kind`` name, its options (a ``Spec`` dataclass deriving from :class:`TableSpec`, or from
+:class:`Compared` where it matches published cells) and a ``build`` method; a spec in ``report.tables`` then
+names it, and the config check holds the spec to the options before any run (:func:`table_specs`).
 """
 
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -24,6 +26,8 @@ from replication.evidence.named_conditions import as_mapping, holds, instead_of,
 from replication.evidence.published import cells
 from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import Outcome, Verdict
+from replication.kinds import Registry
+from replication.specs import Spec
 
 # the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
 # these, so the index shows how far the cells' verdicts move with it
@@ -192,7 +196,7 @@ def _estimate_columns(frame: pd.DataFrame) -> list[str]:
     return [c for c in frame.columns if len(frame) and all(isinstance(v, Estimate) for v in frame[c])]
 
 
-def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: dict) -> pd.DataFrame:
+def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: "Compared") -> pd.DataFrame:
     """The published cells our row (``method``, at the condition of ``ours``: a row with its label
     ``condition`` and its ``condition.<variable>`` columns) is compared with.
 
@@ -205,19 +209,19 @@ def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: dict) -> pd.Da
                   {"condition": ours["condition"]})
     chosen = theirs["method"] == method
     if "condition" in wanted:
-        chosen &= theirs["condition"].replace("", spec.get("paper_condition", "")) == wanted["condition"]
+        chosen &= theirs["condition"].replace("", spec.paper_condition) == wanted["condition"]
     if "experiment" in wanted:
         chosen &= theirs["experiment"] == wanted["experiment"]
     return theirs[chosen]
 
 
-def matched(spec: dict) -> list[tuple[dict, dict]]:
+def matched(spec: "Compared") -> list[tuple[dict, dict]]:
     """A table's ``match:``, each entry ``{ours: {scene: Girl}, paper: {experiment: single_object, condition:
     "N=10;runs=100"}}``: a condition of ours (a mapping of values,
     :mod:`~replication.evidence.named_conditions`) and the paper's cells it is compared with, by their
     experiment and their condition as ``published_values.csv`` writes it (the paper's, not ours)."""
-    entries = spec.get("match") or []
-    where = f"table {spec.get('name')!r}: match"
+    entries = spec.match or []
+    where = f"table {spec.name!r}: match"
     if isinstance(entries, Mapping):  # keyed by our condition's label
         label, paper = next(iter(entries.items()))
         paper = written(paper if isinstance(paper, Mapping) else {"condition": paper})
@@ -229,29 +233,85 @@ def matched(spec: dict) -> list[tuple[dict, dict]]:
     return [(as_mapping(entry.get("ours"), where), dict(entry["paper"])) for entry in entries]
 
 
+@dataclass(frozen=True, kw_only=True)
+class TableSpec(Spec):
+    """What every table spec names: the table (its CSV's and HTML's file name), its title, its kind."""
+
+    name: str
+    title: str = ""
+    kind: str = ""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Compared(TableSpec):
+    """A table matched with the paper's cells: those of ``paper_table`` (one or a list; none: a user's own
+    table) and ``paper_metric`` (default: the table's metric), matched by ``match`` (:func:`matched`), a cell
+    stated without its condition taking ``paper_condition``."""
+
+    paper_table: str | list[str] | None = None
+    paper_metric: str | None = None
+    match: Any = None
+    paper_condition: str = ""
+
+    @property
+    def published_metric(self) -> str | None:
+        """The metric of the paper's cells this table compares with."""
+        return self.paper_metric
+
+    @property
+    def paper_tables(self) -> list[str]:
+        table = self.paper_table
+        return [] if table is None else [str(t) for t in table] if isinstance(table, list) else [str(table)]
+
+
+TABLE_KINDS: Registry[type["TableKind"]] = Registry("table kind")
+
+
+def table_spec(written: Mapping | TableSpec, where: str = "") -> TableSpec:
+    """A table spec as its kind declares it (``kind:``; a list of ``metrics:`` is a summary, else a comparison),
+    checked (:meth:`~replication.specs.Spec.of`); ``where``: the file it is written in."""
+    if isinstance(written, TableSpec):
+        return written
+    name = written.get("name") if isinstance(written, Mapping) else None
+    where = f"{where}: table {name!r}" if where else f"table {name!r}"
+    if not isinstance(written, Mapping):
+        raise ConfigError(f"{where}: a table is a mapping of options, got {written!r}")
+    kind = written.get("kind") or ("summary" if "metrics" in written else "comparison")
+    try:
+        made = TABLE_KINDS[kind]
+    except ConfigError as error:
+        raise ConfigError(f"{where}: {error}") from None
+    return made.Spec.of({**written, "kind": kind}, f"{where} ({kind})")
+
+
+def table_specs(experiment: Mapping, where: str = "") -> tuple[TableSpec, ...]:
+    """The experiment's report tables as typed specs (``where``: its file, said in an error)."""
+    return tuple(table_spec(written, where) for written in (experiment.get("report") or {}).get("tables") or ())
+
+
 class TableKind:
-    """One kind of report table; subclasses register themselves by ``kind``."""
+    """One kind of report table; subclasses register themselves by ``kind`` and declare their options
+    (``Spec``)."""
 
     kind: ClassVar[str]
+    Spec: ClassVar[type[TableSpec]] = TableSpec
     compares: ClassVar[bool] = True  # whether its rows are matched with published cells
     reads: ClassVar[tuple[str, ...]] = ()  # the per-frame series of a run it is built from (the record keeps them)
-    registry: ClassVar[dict[str, type["TableKind"]]] = {}
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        TableKind.registry[cls.kind] = cls
+        TABLE_KINDS.register(cls.kind, cls)
 
-    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None):
+    def __init__(self, spec: TableSpec, experiment: dict, published: pd.DataFrame, footage: Footage | None = None):
         self.spec, self.experiment, self.published, self.footage = spec, experiment, published, footage
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame, footage: Footage | None = None) -> "TableKind":
-        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison);
+    def of(cls, spec: Mapping | TableSpec, experiment: dict, published: pd.DataFrame,
+           footage: Footage | None = None) -> "TableKind":
+        """The table kind a spec names, built on its typed spec (a mapping is checked first: :func:`table_spec`);
         ``footage``: the video the runs saw, for a kind that reads it (the caller's)."""
-        name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
-        if name not in cls.registry:
-            raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
-        return cls.registry[name](spec, experiment, published, footage)
+        spec = table_spec(spec)
+        return TABLE_KINDS[spec.kind](spec, experiment, published, footage)
 
     def build(self, records: pd.DataFrame) -> Table:
         raise NotImplementedError
@@ -260,15 +320,14 @@ class TableKind:
         return method_label(self.experiment, method)
 
     def theirs(self) -> pd.DataFrame:
-        spec = self.spec
-        return cells(self.published, self.experiment["paper"], spec.get("paper_table"),  # none: a user's own table
-                     spec.get("paper_metric", spec.get("metric")))
+        return cells(self.published, self.experiment["paper"], self.spec.paper_table,  # none: a user's own table
+                     self.spec.published_metric)
 
     def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, rating: str = ""
               ) -> CellResult:
         """A matched published cell for ``summary.json``: the cell's keys and our row's numbers."""
         cell = self.published.loc[index]
-        return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec["name"],
+        return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec.name,
                           our_method=row["method"], our_condition="" if row["condition"] == "-" else row["condition"],
                           runs=int(row["runs"]),
                           paper_number=None if pd.isna(cell["number"]) else float(cell["number"]),

@@ -31,7 +31,8 @@ from replication.condition import PREFIX, values_of
 from replication.display import method_label
 from replication.evidence.footage import Footage
 from replication.report.figures.style import save
-from replication.report.figures.base import figure
+from replication.evidence.figures import IdentityTimeline, TrackSnapshots, TrackVideo
+from replication.report.figures.base import draws
 
 # tab10 then Dark2, both without their grey (kept for the ignore regions) and without light tints (which
 # would read as the white truth): 16 saturated colours, consecutive ids (mostly alive at the same time)
@@ -93,28 +94,28 @@ def _panel(ax, sequence: Any, frame: int, tracks: pd.DataFrame, fontsize: float 
     ax.set_title(f"frame {frame}", fontsize=7, pad=2)
 
 
-def _window(spec: dict, sequence: Any, frames: list[int], tables: list[pd.DataFrame],
+def _window(spec: TrackSnapshots, sequence: Any, frames: list[int], tables: list[pd.DataFrame],
             margin: float = 40) -> tuple[float, float, float, float]:
     """The part of a scene's frames the snapshots show: the boxes of ``tables`` in ``frames`` with a
     ``margin`` (px) around them, or the whole frame with ``crop: false``."""
     width, height = sequence.size
     boxes = pd.concat([table[table["frame"].isin(frames)] for table in tables])[BOX].to_numpy(float)
-    if spec.get("crop", True) is False or not len(boxes):
+    if spec.crop is False or not len(boxes):
         return 0, 0, width, height
     x0, y0 = np.maximum(boxes[:, :2].min(axis=0) - margin, 0)
     x1, y1 = np.minimum((boxes[:, :2] + boxes[:, 2:]).max(axis=0) + margin, (width, height))
     return float(x0), float(y0), float(x1), float(y1)
 
 
-def _snapshot_frames(spec: dict, scene: str, run: pd.Series, n_frames: int) -> list[int]:
+def _snapshot_frames(spec: TrackSnapshots, scene: str, run: pd.Series, n_frames: int) -> list[int]:
     """The frames of a scene's snapshots: ``spec.frames`` (a list, or a list per scene key), else
     ``spec.columns`` (4) frames evenly spaced over the run's."""
-    frames = spec.get("frames")
+    frames = spec.frames
     if isinstance(frames, dict):
         frames = frames.get(scene)
     if frames is None:
         first, last = int(run["first_frame"]), int(run["last_frame"])
-        frames = np.unique(np.linspace(first, last, spec.get("columns", 4)).round().astype(int))
+        frames = np.unique(np.linspace(first, last, spec.columns).round().astype(int))
     return [int(k) for k in frames if 1 <= k <= n_frames]
 
 
@@ -122,8 +123,9 @@ CAPTION = ("Coloured boxes: the tracker's output, one colour per track id (its n
            "white: ground truth; dashed grey: regions MOTChallenge ignores.")
 
 
-@figure("track_snapshots", reads=("tracks",), footage=True)
-def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
+@draws(TrackSnapshots)
+def track_snapshots(records: pd.DataFrame, spec: TrackSnapshots, experiment: dict, path: Path,
+                    footage: Footage) -> Path:
     """Frames of the real video with each method's output (its first run), one row per method and condition,
     one column per frame of ``spec.frames`` (``{<scene key>: [MOT frame numbers]}`` or one list for every
     scene; by default ``spec.columns``, 4, frames evenly spaced over the run).  The panels show the part of
@@ -180,8 +182,9 @@ def timeline_matches(sequence: Any, run, footage: Footage) -> tuple[pd.DataFrame
     return truth, footage.matches(truth, tracks, ignored)
 
 
-@figure("identity_timeline", reads=("tracks",), footage=True)
-def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
+@draws(IdentityTimeline)
+def identity_timeline(records: pd.DataFrame, spec: IdentityTimeline, experiment: dict, path: Path,
+                      footage: Footage) -> Path:
     """Which output track held which person, frame by frame: one panel per method (its first run) and
     condition, one lane per ground-truth id, a bar in the matched track's colour (its id written in it)
     where CLEAR MOT matches them (IoU >= 0.5, a match kept while it holds), a grey line where the person
@@ -230,16 +233,16 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
     return save(fig, path, dpi=130)
 
 
-def _video_run(records: pd.DataFrame, spec: dict) -> pd.Series:
+def _video_run(records: pd.DataFrame, spec: TrackVideo) -> pd.Series:
     """The first run of ``spec.method`` (default: the first method) in ``spec.scene``'s condition (default:
     the first condition the method has)."""
-    method = spec.get("method", records["method"].iloc[0])
+    method = spec.method or records["method"].iloc[0]
     runs = records[records["method"] == method]
-    if "scene" in spec:
-        runs = runs[values_of(runs, "scene") == spec["scene"]]
+    if spec.scene is not None:
+        runs = runs[values_of(runs, "scene") == spec.scene]
     if runs.empty:
-        raise ValueError(f"track_video: no run of method {method!r}" + (f" on scene {spec['scene']!r}"
-                                                                        if "scene" in spec else ""))
+        raise ValueError(f"track_video: no run of method {method!r}" + (f" on scene {spec.scene!r}"
+                                                                        if spec.scene is not None else ""))
     runs = runs[runs["condition"] == runs["condition"].iloc[0]]
     return runs.sort_values("repetition").iloc[0]
 
@@ -308,8 +311,8 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
     return path
 
 
-@figure("track_video", reads=("tracks",), footage=True)
-def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path, footage: Footage) -> Path:
+@draws(TrackVideo)
+def track_video(records: pd.DataFrame, spec: TrackVideo, experiment: dict, path: Path, footage: Footage) -> Path:
     """An animated GIF of one run, and a PNG poster as the figure: its first frame with an output box.
 
     The run is the first of ``spec.method`` (default: the first method) on ``spec.scene`` (a scene key;
@@ -320,13 +323,13 @@ def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
     """
     run = _video_run(records, spec)
     sequence = footage.mot_sequence(experiment, run[f"{PREFIX}scene"])
-    first, last = spec.get("frames", (int(run["first_frame"]), int(run["first_frame"]) + 99))
+    first, last = spec.frames or (int(run["first_frame"]), int(run["first_frame"]) + 99)
     first = max(int(first), int(run["first_frame"]), 1)
     last = min(int(last), int(run["last_frame"]), sequence.n_frames)
     tracks = footage.tracks(run)
-    animation = path.parent / spec.get("link", path.with_suffix(".gif").name)
-    frames = [video_frame(sequence, k, tracks, spec.get("width", 384)) for k in range(first, last + 1)]
-    write_gif(frames, animation, spec.get("fps", sequence.frame_rate))
+    animation = path.parent / (spec.link or path.with_suffix(".gif").name)
+    frames = [video_frame(sequence, k, tracks, spec.width) for k in range(first, last + 1)]
+    write_gif(frames, animation, sequence.frame_rate if spec.fps is None else spec.fps)
     width, height = sequence.size
     shown = _between(tracks, first, last)["frame"]
     poster = int(shown.min()) if len(shown) else first

@@ -15,7 +15,7 @@ from omegaconf import DictConfig
 
 import replication
 from replication import atomic
-from replication.evidence.claims import Result
+from replication.evidence.checks import Result
 from replication.evidence.footage import Footage
 from replication.evidence.judge import Judgement
 from replication.evidence.settings import rules
@@ -25,6 +25,7 @@ from replication.report.pages.scale import scale_note
 from replication.report.pages.sequences import write_sequence_pages
 from replication.scales import index_from
 from replication.report.figures.style import NothingToDraw
+from replication.evidence.figures import figure_specs
 
 SHOWN = 12  # of the differences a user's request makes, those the page lists (the digest covers them all)
 
@@ -52,7 +53,6 @@ def write_experiment_report(cfg: DictConfig, judged: Judgement, shown: Shown) ->
     ``<reports>/quick/<experiment>/``) from its ``judged`` runs: its tables as CSV and HTML, its figures, the page
     and ``summary.json``; return the page's path."""
     experiment, records, summary, out = judged.experiment, judged.records, judged.summary, shown.out
-    spec = experiment.get("report", {})
     tables, figures, left_out = [], [], []
     for written in summary.tables:
         table = judged.tables[written["name"]]
@@ -60,17 +60,17 @@ def write_experiment_report(cfg: DictConfig, judged: Judgement, shown: Shown) ->
         html = html_table(table.shown())
         atomic.write_text(out / f"{written['name']}.html", html)
         tables.append({**written, "html": html})
-    for figure_spec in spec.get("figures", []) if len(records) else ():
-        file = f"{figure_spec['name']}.png"
+    for figure_spec in figure_specs(experiment) if len(records) else ():
+        file = f"{figure_spec.name}.png"
         try:
-            draw(records, figure_spec, experiment, out / file, shown.published, shown.curves.get(figure_spec["name"]),
+            draw(records, figure_spec, experiment, out / file, shown.published, shown.curves.get(figure_spec.name),
                  footage=shown.footage)
         except NothingToDraw as reason:  # as a table none of whose conditions ran: left out, and said
             left_out.append(str(reason))
             continue
-        link = {"link": figure_spec["link"]} if "link" in figure_spec else {}  # a file the figure wrote too
-        beside = {"beside": figure_spec["beside"]} if "beside" in figure_spec else {}  # under that table
-        figures.append({"name": figure_spec["name"], "title": figure_spec["title"], "file": file, **link, **beside})
+        link = {"link": figure_spec.linked} if figure_spec.linked else {}  # a file the figure wrote too
+        beside = {"beside": figure_spec.beside} if figure_spec.beside else {}  # under that table
+        figures.append({"name": figure_spec.name, "title": figure_spec.title, "file": file, **link, **beside})
     sequences = write_sequence_pages(records, experiment, out, shown.footage) if len(records) else []
     failures = Counter(summary.failed)
     unmatched = judged.unmatched
