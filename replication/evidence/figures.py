@@ -13,7 +13,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
-
 from replication.errors import ConfigError
 from replication.kinds import Registry
 from replication.specs import Spec
