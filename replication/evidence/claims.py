@@ -25,6 +25,7 @@ from replication.errors import ConfigError
 from replication.evidence.checks import Result
 from replication.evidence.claim_tests import ClaimSpec, ClaimTest, claim_spec, named
 from replication.evidence.tables import Table
+from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR
 
 CLAIMS_DIR = CONF_DIR / "claims"
@@ -150,6 +151,11 @@ def evaluate(name: str, experiment: dict, records: pd.DataFrame, tables: dict[st
                 if reading.experiment != name:
                     continue
                 test = ClaimTest.of(reading.test, experiment, published)
+                absent = [column for column in reading.test.reads if len(records) and column not in records]
+                if absent:  # runs computed before the column was measured (the record's older runs, say)
+                    why = f"no run recorded {absent[0]}: computed by code that did not measure it"
+                    results.setdefault(claim.id, {})[reading.name] = Result(Verdict(Outcome.NOT_TESTABLE, why))
+                    continue
                 checks = test.checks(records, tables) if len(records) or not test.needs_runs else []
                 results.setdefault(claim.id, {})[reading.name] = Result.of(checks)
     return results

@@ -29,6 +29,12 @@ class ClaimSpec(Spec):
         return (self.conditions,)
 
     @property
+    def reads(self) -> tuple[str, ...]:
+        """The run columns its test reads (a metric, a cost): on runs that recorded none of one, the reading
+        is not testable (runs computed before the column was measured)."""
+        return ()
+
+    @property
     def basis(self) -> str:
         """What the methods are compared at: "" where at the paper's own settings (equal N), else the budget
         they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""

@@ -49,6 +49,10 @@ class Order(ClaimTest):
         tolerance: float = 0.0
         size: dict[str, Any] | None = None
 
+        @property
+        def reads(self) -> tuple[str, ...]:
+            return (self.metric,)
+
     def checks(self, records, tables):
         metric, scale = self.spec.metric, self.spec.scale
         kind = quantity(metric)
@@ -128,6 +132,10 @@ class EqualCost(ClaimTest):
         baseline: str | list[str]
         scale: float = 1.0
         unit: str = ""
+
+        @property
+        def reads(self) -> tuple[str, ...]:
+            return (self.metric, self.cost)
 
         @property
         def basis(self) -> str:

@@ -38,6 +38,10 @@ class Threshold(ClaimTest):
         unit: str = ""
 
         @property
+        def reads(self) -> tuple[str, ...]:
+            return (self.metric,)
+
+        @property
         def naming(self) -> tuple:
             return (self.conditions, self.condition)
 
@@ -112,6 +116,10 @@ class Growth(ClaimTest):
         metric: str
         x: str
         at_most: float
+
+        @property
+        def reads(self) -> tuple[str, ...]:
+            return (self.metric,)
 
     def checks(self, records, tables):
         spec = self.spec
