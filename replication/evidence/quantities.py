@@ -99,6 +99,7 @@ QUANTITIES = {
     "wall_s": Quantity("timing", label="wall time (s)"),
     "cpu_s": Quantity("timing", label="CPU time (s)"),
     "load_1m": Quantity("positive", label="machine load (1-minute average)"),
+    "reference_ms": Quantity("timing", label="reference work (ms): the machine's speed"),
     "fps": Quantity("timing", lower_is_better=False, label="frames per second"),
     # the papers' own names for what their tables print (a published cell's metric)
     "time": Quantity("timing", label="time per step (ms)"),
