@@ -74,7 +74,7 @@ replicate: setup
 	$(if $(filter paper,$(SCALE)),$(MAKE) record)
 	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
-	$(BIN)/python -m replication.report.pages.calibration
+	$(BIN)/python -m replication.report.calibration
 	$(BIN)/python -m replication.report.pdf
 
 # At SCALE=paper the universes the record holds as this code computes them are read from it, not run
@@ -103,7 +103,7 @@ report: setup
 	$(BIN)/python -m replication.report scale=$(SCALE)
 
 calibrate: setup
-	$(BIN)/python -m replication.report.pages.calibration
+	$(BIN)/python -m replication.report.calibration
 
 docs: setup
 	$(BIN)/python -m pdoc -o reports/api replication

@@ -32,6 +32,7 @@ import hydra
 from omegaconf import DictConfig
 
 from replication import __version__
+from replication.arguments import names
 from replication.atomic import DiskFull
 from replication.errors import ConfigError, fail
 from replication.evidence.settings import configure
@@ -83,13 +84,13 @@ def experiment_file(name: str, argv: list[str]) -> Path:
 def chosen_experiments(argv: list[str]) -> dict[str, dict]:
     """The experiments the command line names (several in a multirun), each checked to exist and to
     parse, with its file as written; none for Hydra's own flags, which describe the app rather than run it."""
-    chosen = [arg.split("=", 1)[1] for arg in argv if arg.startswith("experiment=")]
+    chosen = [arg.partition("=")[2] for arg in argv if arg.startswith("experiment=")]
     if not chosen and any(arg in HYDRA_FLAGS for arg in argv):
         return {}
     if not chosen:
         known = ", ".join(experiment_names(*config_dirs(argv)))
         raise ConfigError(f"name an experiment: pf-replicate experiment=<name>; known: {known}")
-    return {name: check_yaml(experiment_file(name, argv)) for name in chosen[-1].split(",")}
+    return {name: check_yaml(experiment_file(name, argv)) for name in names(chosen[-1])}
 
 
 def own_claims(argv: list[str]) -> list[str]:
@@ -192,14 +193,14 @@ def run_experiment(cfg: DictConfig) -> None:
         stored = len(computed) - done
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
               + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
-        from replication.report.pages.experiment import write_experiment_report
+        from replication.report.experiments import write_experiment
         from replication.report.pages.index import write_index
         from hydra.core.hydra_config import HydraConfig
 
         from replication.runner.results import Results
 
         results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
-        written = write_experiment_report(cfg, results)
+        written = write_experiment(cfg, results)  # judged (evidence), then drawn (report)
         index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
         print(f"{cfg.experiment.name}: report in {written}; index in {index}")
         if results.own and cfg.experiment.get("also"):
@@ -284,11 +285,10 @@ def run_multiverse(cfg: DictConfig) -> None:
                       + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
         from hydra.core.hydra_config import HydraConfig
 
+        from replication.report.experiments import write_multiverse
         from replication.report.pages.index import write_index
-        from replication.report.pages.multiverse import write_multiverse_report
 
-        written = write_multiverse_report(cfg, multiverse, tuple(HydraConfig.get().overrides.task),
-                                          reader(recorded, layers))
+        written = write_multiverse(cfg, multiverse, tuple(HydraConfig.get().overrides.task), reader(recorded, layers))
         index = write_index(resolve(cfg.reports), cfg.published_values)
         print(f"{name}: report in {written}; index in {index}")
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'

@@ -31,6 +31,7 @@ import re
 import shutil
 import sys
 from collections import defaultdict
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,7 @@ from hydra.errors import HydraException
 from omegaconf.errors import OmegaConfBaseException
 
 from replication import atomic
+from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.paths import experiment_names, resolve
 from replication.run import Run
@@ -106,20 +108,29 @@ def _save(path: Path, values: np.ndarray, fmt: str) -> None:
     atomic.save(path, lambda tmp: np.savetxt(tmp, values, fmt=fmt, delimiter=","))
 
 
+@dataclass(frozen=True)
+class Options:
+    """The export's own settings; every other key=value is a setting of the config (store=, experiment.*)."""
+
+    experiment: str | None = None
+    scale: str | None = None
+    layout: str | None = None  # one of LAYOUTS (every one by default)
+    out: str | None = None
+    reports: str | None = None  # where out= is by default (and a setting of the config)
+
+
 def main(argv: list[str]) -> None:
-    bare = [arg for arg in argv if "=" not in arg]
-    if bare:
-        fail(f"arguments are key=value; got {' '.join(bare)}")
-    options = dict(arg.split("=", 1) for arg in argv)
-    name = options.pop("experiment", None)
+    options, overrides = read(argv, Options, "export", handed=("*",))
+    name = options.experiment
     if name not in experiment_names():
         fail(f"name a tracking experiment: experiment=<name>; known: {', '.join(experiment_names())}")
-    scale = options.pop("scale", None) or default_scale()
-    layouts = [options.pop("layout")] if "layout" in options else list(LAYOUTS)
-    out = Path(options.pop("out", report_folder(resolve(options.get("reports", "reports")), name, scale) / "results"))
+    scale = options.scale or default_scale()
+    layouts = [options.layout] if options.layout is not None else list(LAYOUTS)
+    out = Path(options.out or report_folder(resolve(options.reports or "reports"), name, scale) / "results")
+    overrides = [*overrides, *([f"reports={options.reports}"] if options.reports is not None else [])]
     try:
         for layout in layouts:
-            written = export_results(name, scale, out, layout, tuple(f"{k}={v}" for k, v in options.items()))
+            written = export_results(name, scale, out, layout, tuple(overrides))
             if not written:
                 fail(f"no stored run of {name} at scale {scale} is on an OTB sequence: "
                      f"run python -m replication experiment={name} scale={scale} first")

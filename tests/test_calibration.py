@@ -8,7 +8,8 @@ import yaml
 from replication.evidence import calibration
 from replication.evidence.settings import INFERENCE
 from replication.paths import CONF_DIR, PACKAGE_DIR
-from replication.report.pages.calibration import CSV, NOTE, evidence_digest, failures, read, write_calibration
+from replication.report.calibration import CSV, NOTE, evidence_digest, read, write_calibration
+from replication.report.pages.calibration import failures
 from replication.evidence.claims import load_papers
 
 SHIPPED = PACKAGE_DIR.parent / "reports" / CSV

@@ -12,7 +12,9 @@ from conftest import PROJECT_ROOT, typed
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, resolve
-from replication.evidence.claims import Check, ClaimTest, Reading, Result, load_papers
+from replication.evidence.checks import Check, Result
+from replication.evidence.claim_tests import ClaimTest, claim_spec
+from replication.evidence.claims import Reading, load_papers
 from replication.evidence.published import load_published
 from replication.evidence.settings import INFERENCE
 
@@ -43,12 +45,12 @@ def test_every_reading_names_a_real_experiment_methods_and_tables():
                     assert experiment["paper"] == paper.key, claim.id
                     test = reading.test
                     ClaimTest.of(test, experiment)  # a known test
-                    named = [m for g in test.get("order", []) for m in ([g] if isinstance(g, str) else g)]
-                    named += [m for k in ("method", "baseline") if k in test
-                              for m in ([test[k]] if isinstance(test[k], str) else test[k])]
+                    named = [m for g in getattr(test, "order", []) for m in ([g] if isinstance(g, str) else g)]
+                    named += [m for k in ("method", "baseline") if test.test != "uniformity" and getattr(test, k, None)
+                              for m in ([getattr(test, k)] if isinstance(getattr(test, k), str) else getattr(test, k))]
                     assert set(named) <= set(experiment["methods"]), (claim.id, reading.name)
                     tables = {t["name"] for t in experiment["report"]["tables"]}
-                    assert set(test.get("tables", [])) <= tables, (claim.id, reading.name)
+                    assert set(getattr(test, "tables", [])) <= tables, (claim.id, reading.name)
 
 
 EXPERIMENT = {"methods": {"A": {}, "B": {}, "C": {}}}
@@ -115,8 +117,8 @@ def test_equal_cost_pairs_the_method_with_the_cheapest_baseline_condition_that_r
     assert [c.what.split(" - ")[0] + " / " + c.what.split(" - ")[1].split(" at ")[0] for c in checks] == [
         "M at N=100 / B", "M at N=100 / B2", "M2 at N=100 / B", "M2 at N=100 / B2"]
     assert {c.estimate.value for c in checks} == {checks[0].estimate.value}  # the same runs under each name
-    assert Reading("r", "e", spec).basis == "likelihood evaluations per step"
-    assert Reading("r", "e", {"test": "order", "order": ["M", "B"]}).basis == ""  # the paper's: equal N
+    assert Reading("r", "e", claim_spec(spec)).basis == "likelihood evaluations per step"
+    assert Reading("r", "e", claim_spec({"test": "order", "metric": "rmse", "order": ["M", "B"]})).basis == ""  # the paper's: equal N
     poor = records[~records["condition"].isin(["N=1400", "N=2000", "N=4000"])]  # no B condition reaches 1100
     (untestable,) = ClaimTest.of(spec, EXPERIMENT).checks(poor, {})
     assert untestable.verdict.outcome is Outcome.NOT_TESTABLE and "at most 1000" in untestable.verdict.why
@@ -235,7 +237,7 @@ def test_a_users_claims_files_are_read_as_the_papers_and_a_broken_one_is_one_lin
         load_own_papers(tmp_path)
     (tmp_path / "mine.yaml").write_text(head + "    claim: c\n    where: s\n    readings:\n"
                                         "      - {name: r, experiment: e, test: faster}\n")
-    with pytest.raises(ConfigError, match=r"mine.yaml: unknown claim test 'faster'; known: .*order"):
+    with pytest.raises(ConfigError, match=r"mine.yaml: claim mine.x, reading r: unknown claim test 'faster'; known claim tests: .*order"):
         load_own_papers(tmp_path)
 
 
@@ -282,7 +284,7 @@ def test_cells_reads_a_rating_tables_verdicts_and_the_proportion_behind_them():
     records = typed(pd.DataFrame({"method": "A", "condition": "scene=s", "failed": [0.0] * 28 + [1.0] * 12}))
     spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability",
             "match": [{"ours": {"scene": "s"}, "paper": {"experiment": "s"}}]}
-    table = Rating(spec, {"paper": "p", "methods": {"A": {}}}, published).build(records)
+    table = Rating(Rating.Spec.of(spec, "t3"), {"paper": "p", "methods": {"A": {}}}, published).build(records)
     result = Result.of(ClaimTest.of({"test": "cells", "tables": ["t3"]}, EXPERIMENT).checks(records, {"t3": table}))
     assert result.verdict.outcome is Outcome.NOT_REPRODUCED  # 12 of 40 failed: [0.18, 0.45], medium, not good
     assert result.deciding.estimate.value == 0.3 and "(ours: medium)" in result.deciding.what
@@ -373,7 +375,7 @@ def test_each_check_shows_the_interval_of_the_level_it_names():
                               "note": [""], "number": [1.8]})
     spec = {"name": "gain", "kind": "improvement", "paper_table": "1", "metric": "rmse",
             "paper_metric": "rmse_improvement", "baseline": "B", "method": "A", "tolerance_pp": 1.0}
-    table = Improvement(spec, {"paper": "p", "methods": {"A": {}, "B": {}}}, published).build(records)
+    table = Improvement(Improvement.Spec.of(spec, "t"), {"paper": "p", "methods": {"A": {}, "B": {}}}, published).build(records)
     (cell,) = ClaimTest.of({"test": "cells", "tables": ["gain"]}, EXPERIMENT).checks(records, {"gain": table})
     gain = 100 * (runs["B"] - runs["A"]) / runs["B"].mean()
     ninety_five = stats.ttest_1samp(gain, 0.0).confidence_interval(INFERENCE.level)

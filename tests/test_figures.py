@@ -15,8 +15,12 @@ from replication.report import figures
 from replication.report.figures import metric as metric_figures, tracking as tracking_figures
 from replication.evidence.published import load_published
 from replication.evidence.curves import clip_diverged
-from replication.report.figures.style import PALETTE, NothingToDraw, axis_label, method_look
+from replication.evidence.figures import AttributeMap, figure_spec
+from replication.evidence.quantities import QUANTITIES, quantity
+from replication.report.figures.style import LABELS, PALETTE, NothingToDraw, axis_label, method_look
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 PUBLISHED = "paper,table,experiment,method,metric,condition,value,unit,note\n" + "\n".join([
     "qmc,1,ungm,PF,rmse,N=100,9.2,,",
     "qmc,1,ungm,PF,rmse,N=500,4.2,,",
@@ -108,10 +112,10 @@ def test_a_method_looks_the_same_on_figures_of_two_experiments(drawn, tmp_path):
     rng = np.random.default_rng(0)
     figures.draw(_scalar_records({("PF", f"N={n}"): list(rng.uniform(4, 5, 5)) for n in (100, 500)}
                                  | {("grid", ""): [4.0, 4.1]}),
-                 {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, ungm, tmp_path / "a.png")
+                 {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, ungm, tmp_path / "a.png", footage=FOOTAGE)
     figures.draw(_tracking_records({"ISM-PF": rng.uniform(0, 5, (4, 30)).tolist(),
                                     "PF": rng.uniform(0, 5, (4, 30)).tolist()}),
-                 {"kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png")
+                 {"name": "f", "kind": "per_frame_curve", "series": "cle"}, tracking, tmp_path / "b.png", footage=FOOTAGE)
     pf = [_lines(fig, "PF")[0] for fig in drawn]
     assert {to_hex(line.get_color()) for line in pf} == {method_look(ungm, "PF").colour.lower()} == {"#0072b2"}
     assert {line.get_marker() for line in pf} == {method_look(tracking, "PF").marker}
@@ -125,6 +129,11 @@ def test_axis_labels_read_in_words_with_the_raw_name_as_fallback():
     assert axis_label("ms_per_step") == "time per step (ms)"
     assert axis_label("correct_frames[iou>=0.5]") == "share of frames with IoU ≥ 0.5"
     assert axis_label("my_metric") == "my_metric" and axis_label("my_metric[x>1]") == "my_metric[x>1]"
+    # one vocabulary: a metric's words are the tables' and claims' (evidence.quantities), rules read there too
+    assert not set(LABELS) & set(QUANTITIES) and axis_label("mean_ess") == quantity("mean_ess").label
+    assert axis_label("tracked_to_end[cle<=20]") == quantity("tracked_to_end[cle<=20]").label == \
+        "runs tracked to the end (centre error ≤ 20 px)"
+    assert axis_label("N") == "number of particles N"
 
 
 def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_path):
@@ -132,9 +141,9 @@ def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_pat
     csv.write_text(PUBLISHED)
     experiment = {"paper": "qmc", "methods": {"PF": {"filter": "bootstrap"}, "NQMCPF": {"filter": "nqmcpf"}}}
     records = _scalar_records({(m, f"N={n}"): [4.0, 4.5, 5.0] for m in ("PF", "NQMCPF") for n in (100, 200, 500)})
-    spec = {"kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
+    spec = {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N", "paper_table": ["1", "2"],
             "paper_x": {"ungm": 200}}
-    figures.draw(records, spec, experiment, tmp_path / "f.png", published=load_published(str(csv)))
+    figures.draw(records, spec, experiment, tmp_path / "f.png", published=load_published(str(csv)), footage=FOOTAGE)
     paper = {to_hex(line.get_markeredgecolor()): (list(line.get_xdata()), list(line.get_ydata()))
              for line in _lines(drawn[0], "paper")}
     assert paper == {method_look(experiment, "PF").colour.lower(): ([100, 500], [9.2, 4.2]),
@@ -143,7 +152,7 @@ def test_the_papers_values_are_hollow_diamonds_at_their_condition(drawn, tmp_pat
     legend = [t.get_text() for t in drawn[0].axes[0].get_legend().get_texts()]
     assert legend.count("paper") == 1
     figures.draw(records, {k: v for k, v in spec.items() if k != "paper_table"}, experiment, tmp_path / "g.png",
-                 published=load_published(str(csv)))
+                 published=load_published(str(csv)), footage=FOOTAGE)
     assert not _lines(drawn[1], "paper")  # no paper_table: no diamonds
 
 
@@ -155,7 +164,7 @@ def test_the_configs_paper_table_puts_table_1_on_the_rmse_figure(drawn, tmp_path
     spec = next(s for s in config["report"]["figures"] if s["name"] == "rmse_vs_n")
     records = _scalar_records({(m, f"N={n}"): [4.0, 4.5] for m in config["methods"] if m != "grid"
                                for n in (100, 200, 500)})
-    figures.draw(records, spec, config, tmp_path / "rmse.png", published=load_published(str(published)))
+    figures.draw(records, spec, config, tmp_path / "rmse.png", published=load_published(str(published)), footage=FOOTAGE)
     points = sorted((x, y) for line in _lines(drawn[0], "paper") for x, y in zip(line.get_xdata(), line.get_ydata()))
     assert len(points) == 12 and (500, 1.597) in points  # Table 1: four methods at N = 100, 200, 500
 
@@ -176,7 +185,7 @@ def test_diverged_runs_are_clipped_and_counted_on_per_frame_curves(drawn, tmp_pa
     lost = rng.uniform(80, 120, (5, 40))  # a method that loses the target every run: not a divergence
     experiment = {"methods": {"PF": {"label": "PF"}, "MIL": {"label": "MIL"}}}
     figures.draw(_tracking_records({"PF": good.tolist(), "MIL": lost.tolist()}),
-                 {"kind": "per_frame_curve", "series": "cle"}, experiment, tmp_path / "c.png")
+                 {"name": "f", "kind": "per_frame_curve", "series": "cle"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
     pf, mil = _lines(drawn[0], "PF")[0], _lines(drawn[0], "MIL")[0]
     assert _label(drawn[0], "PF") == "PF (2 of 10 runs diverged, clipped)" and _label(drawn[0], "MIL") == "MIL"
     assert max(pf.get_ydata()) < max(mil.get_ydata()) * 10 / 2  # the blown-up run no longer dominates
@@ -185,8 +194,8 @@ def test_diverged_runs_are_clipped_and_counted_on_per_frame_curves(drawn, tmp_pa
 def test_diverged_runs_are_clipped_and_counted_on_metric_curves(drawn, tmp_path):
     experiment = {"methods": {"PF": {"label": "PF"}}}
     records = _scalar_records({("PF", "N=100"): [4.0, 5.0, 1e9, 4.5, 5.5], ("PF", "N=500"): [3.0, np.inf, 3.2, 3.1]})
-    figures.draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, experiment,
-                 tmp_path / "m.png")
+    figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, experiment,
+                 tmp_path / "m.png", footage=FOOTAGE)
     line = _lines(drawn[0], "PF")[0]
     assert _label(drawn[0], "PF") == "PF (2 of 9 runs diverged, clipped)"
     assert line.get_ydata()[0] < 10 * 5.0  # the mean with the 1e9 run counted at 10 times the median
@@ -227,16 +236,19 @@ def test_the_pdf_numbers_its_pages_and_has_an_outline(tmp_path):
 def test_a_figure_limited_to_conditions_draws_only_their_runs(tmp_path, monkeypatch):
     records = typed(pd.DataFrame({"condition": ["scene=a", "scene=b"], "method": ["M", "M"]}))
     with pytest.raises(NothingToDraw, match="no runs at conditions"):  # the page leaves it out, and says so
-        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "conditions": [{"scene": "c"}]}, {},
-                     tmp_path / "f.png")
+        figures.draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N",
+                               "conditions": [{"scene": "c"}]}, {},
+                     tmp_path / "f.png", footage=FOOTAGE)
     no_strip = typed(pd.DataFrame({"condition": ["scene=x"], "method": ["M"], "repetition": [0], "strip": [None]}))
     with pytest.raises(NothingToDraw, match="no run recorded a strip"):  # no run on the 3123 scene
-        tracking_figures.mode_strip(no_strip, {"name": "modes_3123"}, {}, tmp_path / "m.png")
+        tracking_figures.mode_strip(no_strip, figure_spec({"name": "modes_3123", "kind": "mode_strip"}), {},
+                                    tmp_path / "m.png", footage=FOOTAGE)
     with pytest.raises(NothingToDraw, match="drawn from each run's strip, per_frame, which these records do not"):
-        figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png")
+        figures.draw(no_strip.drop(columns="strip"), {"name": "m", "kind": "mode_strip"}, {}, tmp_path / "m.png", footage=FOOTAGE)
     seen = []
-    monkeypatch.setitem(figures.KINDS, "probe", lambda r, s, e, p: seen.append(sorted(r["condition"])) or p)
-    figures.draw(records, {"kind": "probe", "conditions": [{"scene": "b"}]}, {}, tmp_path / "g.png")
+    monkeypatch.setitem(figures.DRAWINGS, AttributeMap,
+                        lambda r, s, e, p, footage: seen.append(sorted(r["condition"])) or p)
+    figures.draw(records, {"name": "g", "kind": "attribute_map", "conditions": [{"scene": "b"}]}, {}, tmp_path / "g.png", footage=FOOTAGE)
     assert seen == [["scene=b"]]
 
 
@@ -251,16 +263,16 @@ def test_the_encounter_strip_marks_a_swap_where_the_per_identity_error_jumps(dra
     truth[:, 0, 0], truth[:, 1, 0], truth[..., 1] = frames * 3.0, 90 - frames * 3.0, 50
     swapped = truth.copy()
     swapped[16:] = truth[16:, ::-1]
-    from replication.evidence import curves
 
-    seen = lambda experiment, runs: SimpleNamespace(truth=truth, size=(200, 100))  # noqa: E731
-    monkeypatch.setattr(tracking_figures, "sequence_seen", seen)
-    monkeypatch.setattr(curves, "sequence_seen", seen)  # the off-image curve's table
+    class Seen(SceneFootage):  # every run saw the hand-made video (the figure and the off-image curve's table)
+        def seen(self, experiment, runs):
+            return SimpleNamespace(truth=truth, size=(200, 100))
     records = typed(pd.DataFrame([{"method": m, "condition": "scene=a", "repetition": 0,
                                    "per_frame": {"box": boxes.tolist(), "targets": [0, 1]}}
                                   for m, boxes in (("A", swapped), ("B", truth))]))
     experiment = {"methods": {"A": {}, "B": {}}}
-    figures.draw(records, {"name": "e", "kind": "encounter_strip", "distance": 20.0}, experiment, tmp_path / "e.png")
+    figures.draw(records, {"name": "e", "kind": "encounter_strip", "distance": 20.0}, experiment, tmp_path / "e.png",
+                 footage=Seen())
     fig = drawn[-1]
     strips = fig.axes[1::2]
     ticks = [[line.get_xdata()[0] for line in ax.get_lines() if to_hex(line.get_color()) == to_hex("C3")]
@@ -268,7 +280,7 @@ def test_the_encounter_strip_marks_a_swap_where_the_per_identity_error_jumps(dra
     assert ticks == [[16, 16], []]  # both estimates of the pair start on the other ball at frame 16
     per_identity = next(line for line in fig.axes[0].get_lines() if line.get_label() == "per identity")
     assert per_identity.get_ydata()[15] < 20 < per_identity.get_ydata()[20]
-    figures.draw(records, {"name": "o", "kind": "outside_curve"}, experiment, tmp_path / "o.png")
+    figures.draw(records, {"name": "o", "kind": "outside_curve"}, experiment, tmp_path / "o.png", footage=Seen())
     assert all((line.get_ydata() == 0).all() for line in drawn[-1].axes[0].get_lines())
 
 
@@ -283,7 +295,7 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
                                    "evaluations_per_step": e, "ms_per_step": s * (1 + 0.01 * r)}
                                   for m, c, e, s, values in rows for r, v in enumerate(values)]))
     experiment = {"methods": {}}
-    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png")
+    figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "rmse"}, experiment, tmp_path / "c.png", footage=FOOTAGE)
     work, time = drawn[0].axes[:2]
     pf = next(line for line in work.get_lines() if line.get_label() == "PF")  # two budgets: a line and its band
     assert pf.get_xdata().tolist() == [100, 500] and pf.get_ydata() == pytest.approx([5.0, 4.0])  # ordered by cost
@@ -296,7 +308,7 @@ def test_error_against_cost_puts_each_condition_at_its_mean_cost_and_leaves_out_
     hspf = next(c for c in time.containers if c.get_label() == "HSPF").lines[0]
     assert hspf.get_xdata()[0] == pytest.approx(1.8 * 1.01)  # the median time over runs
     with pytest.raises(ValueError, match="the runs have no"):
-        figures.draw(records, {"kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png")
+        figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "mota"}, experiment, tmp_path / "d.png", footage=FOOTAGE)
 
 
 def test_error_against_cost_paired_to_a_reference_draws_run_by_run_differences(keep_figures, tmp_path):
@@ -311,8 +323,8 @@ def test_error_against_cost_paired_to_a_reference_draws_run_by_run_differences(k
     records = typed(pd.DataFrame([{"method": m, "condition": c, "data_condition": "", "repetition": r, "rmse": v,
                                    "evaluations_per_step": e, "ms_per_step": 0.1 + e / 1e3}
                                   for m, c, e, values in rows for r, v in enumerate(values)]))
-    figures.draw(records, {"kind": "metric_vs_cost", "metric": "rmse", "paired_to": "grid"}, {"methods": {}},
-                 tmp_path / "p.png")
+    figures.draw(records, {"name": "f", "kind": "metric_vs_cost", "metric": "rmse", "paired_to": "grid"}, {"methods": {}},
+                 tmp_path / "p.png", footage=FOOTAGE)
     work = drawn[0].axes[0]
     (pf,) = [line for line in work.get_lines() if line.get_label() == "PF"]
     assert pf.get_ydata() == pytest.approx([0.4, 0.1])

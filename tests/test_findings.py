@@ -2,18 +2,21 @@
 record renders (a changed record without regenerated findings fails here), a template naming what the
 record lacks fails in one line, and the numbers are shown as the report shows them."""
 
+import io
 import json
 import shutil
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from replication.paths import PACKAGE_DIR
 from replication.record.manifest import MANIFEST, PAGES
 from replication.report.__main__ import findings, main as report
-from replication.report.findings import (README, README_MARKS, README_TEMPLATE, Drawn, drawn_inputs, duration, estimate,
-                                         inputs, number, readme_part, record_digest, render, stale, write_html,
-                                         write_pages)
+from replication.evidence.scorecard import Scorecard
+from replication.evidence.tables import interval as estimate, number
+from replication.report.findings import (README, README_MARKS, README_TEMPLATE, Drawn, drawn_inputs, duration, inputs,
+                                         readme_part, record_digest, render, stale, write_html, write_pages)
 
 ROOT = PACKAGE_DIR.parent
 FINDINGS = ROOT / "docs" / "findings"
@@ -75,13 +78,13 @@ def test_the_findings_on_disk_are_what_the_shipped_record_renders(shipped_pages)
 def _drawn(tmp_path: Path) -> Drawn:
     folder = tmp_path / "pages"
     (folder / "exp").mkdir(parents=True)
-    (folder / "claims.csv").write_text("paper,claim_id,claim,quote_english,where,verdict,reason,number,ci_low,ci_high,"
-                                       "level,runs,deciding,robustness\np,p.a,A beats B,A is better than B,Table 1,"
-                                       "reproduced,2 of 2 checks hold,0.123456,0.1,0.15,0.9,20,A - B,one reading\n"
-                                       "p,p.b,C beats D,C is better than D,Table 2,not reproduced,a cell,0.5,0.25,0.75,"
-                                       "0.95,10,C N=1,one reading\n")
-    (folder / "summary.csv").write_text("paper,table,method,condition,metric,paper_value,ours,runs,verdict\n"
-                                        "p,1,A,N=1,rmse,4.2,4.25,20,reproduced\n")
+    claims = io.StringIO("paper,claim_id,claim,quote_english,where,verdict,reason,number,ci_low,ci_high,"
+                         "level,runs,deciding,robustness\np,p.a,A beats B,A is better than B,Table 1,"
+                         "reproduced,2 of 2 checks hold,0.123456,0.1,0.15,0.9,20,A - B,one reading\n"
+                         "p,p.b,C beats D,C is better than D,Table 2,not reproduced,a cell,0.5,0.25,0.75,"
+                         "0.95,10,C N=1,one reading\n")
+    cells = io.StringIO("paper,table,method,condition,metric,paper_value,ours,runs,verdict\n"
+                        "p,1,A,N=1,rmse,4.2,4.25,20,reproduced\n")
     (folder / "exp" / "t.csv").write_text("method,condition,ours,ci_low,ci_high,failed runs\n"
                                           "A,N=1,12345.6,,,3\nB,N=1,0.5,0.25,0.75,0\n")
     (folder / "exp" / "summary.json").write_text(json.dumps({"paper": "p"}))
@@ -95,7 +98,9 @@ def _drawn(tmp_path: Path) -> Drawn:
                          "designed": 17, "before": None}},
         "profile": {"made": {"git_commit": "abcdef123456", "machine": "x86_64 CPU"},
                     "stages": ["frames", "likelihood", "filter", "scoring", "rest"], "methods": methods}}))
-    return Drawn(folder)
+    cells = pd.read_csv(cells, keep_default_na=False, na_values=[""], dtype={"ours": str}).assign(link_text="")
+    decided = Scorecard({}, {}, cells, {}, pd.read_csv(claims, keep_default_na=False, na_values=[""]))
+    return Drawn(folder, decided=decided)
 
 
 def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path):
@@ -185,12 +190,12 @@ def test_findings_writes_the_pages_and_draws_the_record_only_when_needed(tmp_pat
     drawn_from = drawn_inputs(inputs(record, out / "templates", tmp_path / "none.csv"))
     status = json.loads((reports / PAGES / "status.json").read_text())
     (reports / PAGES / "status.json").write_text(json.dumps({**status, "drawn_from": drawn_from}))
-    (out / "templates" / "p.md.j2").write_text('{{ claim("p.a").verdict }}\n')
+    (out / "templates" / "p.md.j2").write_text('{{ experiment("exp").runs }}\n')
     drew = []
     monkeypatch.setattr("replication.report.__main__.main", lambda argv: drew.append(argv))
     argv = [f"record={record}", f"reports={reports}", f"findings={out}", f"published_values={tmp_path / 'none.csv'}"]
     findings(argv)
-    assert (out / "p.md").read_text() == "reproduced\n" and not drew
+    assert (out / "p.md").read_text() == "40\n" and not drew
     assert stale(out, inputs(record, out / "templates", tmp_path / "none.csv"), tmp_path / "README.md") == []
     (record / MANIFEST).write_text('{"changed": 1}')  # another record: its pages are drawn again first
     findings(argv)

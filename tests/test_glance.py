@@ -6,7 +6,9 @@ import math
 import matplotlib.image as mpimg
 import pytest
 
-from replication.evidence.claims import Check, load_papers
+from replication.evidence.checks import Check
+
+from replication.evidence.claims import load_papers
 from replication.evidence.scorecard import ClaimRow, ReadingResult
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict

@@ -1,12 +1,18 @@
 """The deciding layer looks only down: replication/evidence/ imports numpy, scipy and pandas, never the
-report, the runner, matplotlib or Jinja (read from the source with ast, so nothing is imported)."""
+report, the runner, matplotlib or Jinja, and nothing that loads OpenCV or numba; the report's pages and figures
+only draw, importing no runner, task, metric or scene (read from the source with ast, so nothing is imported,
+except where a fresh interpreter checks what importing the evidence loads)."""
 
 import ast
+import subprocess
+import sys
 
 from replication.paths import PACKAGE_DIR
 
 FORBIDDEN = ("replication.report", "replication.runner", "replication.cli", "matplotlib", "jinja2", "omegaconf",
-             "hydra")
+             "hydra", "cv2", "numba", "replication.scenes", "replication.metrics", "replication.tasks",
+             "replication.filters", "replication.compiled", "replication.vision", "replication.smc")
+BENEATH_THE_PAGES = ("replication.runner", "replication.tasks", "replication.metrics", "replication.scenes")
 
 
 def _imports(path) -> set[str]:
@@ -25,6 +31,27 @@ def test_evidence_imports_nothing_above_it():
     for path in files:
         upward = {name for name in _imports(path) if name.startswith(FORBIDDEN)}
         assert not upward, (path.name, upward)
+
+
+def test_evidence_loads_neither_opencv_nor_numba():
+    """Importing the evidence (the judge with it) in a fresh interpreter loads no OpenCV and no numba, however
+    deep the imports go: what needs video or compiled code reaches it as data from the caller."""
+    code = ("import sys, replication.evidence, replication.evidence.judge, replication.evidence.tables; "
+            "print(sorted(m for m in ('cv2', 'numba') if m in sys.modules))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert loaded.strip() == "[]", loaded
+    assert "numba" in subprocess.run([sys.executable, "-c", "import sys, replication.runner.footage; "
+                                      "print(sorted(sys.modules))"], capture_output=True, text=True,
+                                     check=True).stdout  # the check can fail: what the caller uses loads it
+
+
+def test_pages_and_figures_import_no_runner_task_metric_or_scene():
+    """A page or figure draws what the judge and the caller hand it; it computes nothing from the runs."""
+    drawing = [*(PACKAGE_DIR / "report" / "pages").rglob("*.py"), *(PACKAGE_DIR / "report" / "figures").rglob("*.py")]
+    assert len(drawing) >= 15
+    for path in drawing:
+        below = {name for name in _imports(path) if name.startswith(BENEATH_THE_PAGES)}
+        assert not below, (path.relative_to(PACKAGE_DIR).as_posix(), below)
 
 
 def test_the_record_imports_nothing_above_it():

@@ -19,7 +19,9 @@ from replication.report.figures import draw
 from replication.report.pages.render import render
 from replication.scenes import load_mot
 from replication.tasks.mot import frame_table
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 EXPERIMENT = {"methods": {"SORT": {"label": "SORT"}, "detections_only": {}},
               "scenes": {"pets": {"kind": "mot", "name": "PETS09-S2L1"}}}
 FIRST, LAST = 101, 250  # the stand-in runs' frames
@@ -83,7 +85,7 @@ def test_the_timeline_matches_are_motmetrics_matches_on_pets():
     sequence = load_mot("PETS09-S2L1")
     run = {"tracks": sort(sequence.detections)[COLUMNS].values.tolist(), "first_frame": 1,
            "last_frame": sequence.n_frames}
-    truth, ours = mot_figures.timeline_matches(sequence, run)
+    truth, ours = mot_figures.timeline_matches(sequence, run, FOOTAGE)
     kept = drop_ignored(frame_table(run), sequence.truth, sequence.ignored)
     theirs = motmetrics_matches(truth, kept)
     assert sorted(ours.itertuples(index=False, name=None)) == theirs
@@ -93,8 +95,8 @@ def test_the_timeline_matches_are_motmetrics_matches_on_pets():
 @needs_mot
 def test_track_snapshots_draw_each_box_in_its_ids_colour(pets, drawn, tmp_path):
     _, records = pets
-    spec = {"kind": "track_snapshots", "frames": {"pets": [120, 180, 240, 900]}}  # 900: beyond the sequence
-    draw(records, spec, EXPERIMENT, tmp_path / "snapshots.png")
+    spec = {"name": "f", "kind": "track_snapshots", "frames": {"pets": [120, 180, 240, 900]}}  # 900: beyond the sequence
+    draw(records, spec, EXPERIMENT, tmp_path / "snapshots.png", footage=FOOTAGE)
     axes = [ax for ax in drawn[0].axes if ax.images]
     assert len(axes) == 2 * 3  # methods x frames
     assert [ax.get_title() for ax in axes[:3]] == ["frame 120", "frame 180", "frame 240"]
@@ -110,19 +112,19 @@ def test_track_snapshots_draw_each_box_in_its_ids_colour(pets, drawn, tmp_path):
     (x0, x1), (y1, y0) = axes[0].get_xlim(), axes[0].get_ylim()
     assert (x1 - x0) * (y1 - y0) < 0.8 * 768 * 576  # cropped to the boxes
     drawn.clear()
-    draw(records, {**spec, "crop": False}, EXPERIMENT, tmp_path / "whole.png")
+    draw(records, {**spec, "crop": False}, EXPERIMENT, tmp_path / "whole.png", footage=FOOTAGE)
     assert next(ax.get_xlim() for ax in drawn[0].axes if ax.images) == (-0.5, 767.5)
 
 
 @needs_mot
 @pytest.mark.parametrize("spec", [
-    {"kind": "track_snapshots"},  # frames evenly spaced over the run
-    {"kind": "identity_timeline"},
-    {"kind": "track_video", "method": "SORT", "frames": [101, 200], "link": "sort.gif"},
+    {"name": "f", "kind": "track_snapshots"},  # frames evenly spaced over the run
+    {"name": "f", "kind": "identity_timeline"},
+    {"name": "f", "kind": "track_video", "method": "SORT", "frames": [101, 200], "link": "sort.gif"},
 ])
 def test_each_kind_writes_a_file(pets, tmp_path, spec):
     _, records = pets
-    path = draw(records, spec, EXPERIMENT, tmp_path / "figure.png")
+    path = draw(records, spec, EXPERIMENT, tmp_path / "figure.png", footage=FOOTAGE)
     assert path == tmp_path / "figure.png" and path.stat().st_size > 10_000
     with Image.open(path) as image:
         assert image.format == "PNG" and min(image.size) > 300
@@ -136,13 +138,13 @@ def test_each_kind_writes_a_file(pets, tmp_path, spec):
 @needs_mot
 def test_the_timeline_draws_a_lane_per_person_and_the_runs_switches(pets, drawn, tmp_path):
     sequence, records = pets
-    draw(records, {"kind": "identity_timeline"}, EXPERIMENT, tmp_path / "timeline.png")
+    draw(records, {"name": "f", "kind": "identity_timeline"}, EXPERIMENT, tmp_path / "timeline.png", footage=FOOTAGE)
     axes = drawn[0].axes
     assert len(axes) == 2
     truth = sequence.truth[sequence.truth["frame"].between(FIRST, LAST)]
     for ax, method in zip(axes, ["SORT", "detections_only"]):
         run = records[records["method"] == method].iloc[0]
-        _, matches = mot_figures.timeline_matches(sequence, run)
+        _, matches = mot_figures.timeline_matches(sequence, run, FOOTAGE)
         assert [t.get_text() for t in ax.get_yticklabels()] == [str(i) for i in sorted(truth["id"].unique())]
         assert ax.get_title().endswith(f"{matches['switch'].sum()} identity switches")
         assert ax.get_xlim() == (FIRST - 0.5, LAST + 0.5)

@@ -10,12 +10,14 @@ from omegaconf import OmegaConf
 from replication.errors import ConfigError
 from replication.evidence.verdict import Outcome, Verdict
 from replication.paths import CONF_DIR, experiment_names
-from replication.evidence.claims import EQUAL_N, Check, Claim, Quote, Reading, Result, load_papers
+from replication.evidence.checks import Check, Result
+from replication.evidence.claim_tests import claim_spec
+from replication.evidence.claims import EQUAL_N, Claim, Quote, Reading, load_papers
 from replication.evidence.multiverse import BASIS, READING, Case, Robustness
 from replication.evidence.robustness import Pairing
 from replication.evidence.schema import Summary
 from replication.evidence.statistics import Estimate
-from replication.report.pages.multiverse import write_multiverse_report
+from replication.report.experiments import write_multiverse
 from replication.runner.config import expand
 from replication.runner.execute import execute
 from replication.runner.multiverse import apply, choices_of, design, load, matches
@@ -108,7 +110,7 @@ def test_a_multiverse_reuses_the_default_runs_and_judges_every_claim_in_every_un
         runs = multiverse.runs_of(name)
         assert execute(runs, Store(tmp_path / "store", name), n_jobs=1, backend="threading", progress=False) \
             == len(runs)
-    page = write_multiverse_report(cfg, multiverse)
+    page = write_multiverse(cfg, multiverse)
     claim = Summary.read(page.parent / "summary.json").multiverse["hspf.ungm"]
     readings = [r.name for p in load_papers() for c in p.claims if c.id == "hspf.ungm" for r in c.readings
                 if r.experiment in multiverse.experiments]  # the equal-cost ones on hspf_ungm_cost included
@@ -131,7 +133,7 @@ def _case(universe: str, picks: dict, outcome: Outcome, reading: str = "r1", hel
     return Case(universe, (*picks.items(), (READING, reading)), Result(Verdict(outcome), checks, deciding))
 
 
-CLAIM = Claim("p.c", "p", "A beats B", Quote("A schlägt B", "A beats B"), "Table 1", {}, (Reading("r1", "e", {}),))
+CLAIM = Claim("p.c", "p", "A beats B", Quote("A schlägt B", "A beats B"), "Table 1", {}, (Reading("r1", "e", claim_spec({"test": "order", "metric": "rmse", "order": ["A", "B"]})),))
 RUNS = dict(enumerate(np.random.default_rng(4).normal(0.3, 1.0, 10)))
 
 
@@ -214,8 +216,9 @@ def test_equal_cost_is_a_named_choice_of_its_own_twinned_with_its_universe_at_eq
     # default: reproduced vs not reproduced (a conflict); x=b: its own r1 (inconclusive) vs reproduced (none)
     assert (at_time.flips, at_time.compared) == (1, 2) and at_time.moves
     assert "compared at equal time per step (ms) (1 of 2 decisive verdicts conflict)" in robustness.flipped_by
-    assert Reading("r", "e", {"test": "order"}).compared_at == EQUAL_N
-    assert Reading("r", "e", {"test": "equal_cost", "cost": "ms_per_step"}).compared_at == "equal time per step (ms)"
+    assert Reading("r", "e", claim_spec({"test": "order", "metric": "rmse", "order": ["A", "B"]})).compared_at == EQUAL_N
+    equal_cost = {"test": "equal_cost", "cost": "ms_per_step", "metric": "rmse", "method": "A", "baseline": "B"}
+    assert Reading("r", "e", claim_spec(equal_cost)).compared_at == "equal time per step (ms)"
 
 
 def test_every_multiverse_config_loads_with_its_defaults_equal_to_the_experiments(tmp_path):

@@ -15,7 +15,7 @@ from replication.errors import ConfigError
 from replication.evidence.claims import evaluate, load_own_papers
 from replication.evidence.named_conditions import as_mapping, holds, matching, same
 from replication.evidence.verdict import Outcome
-from replication.evidence.tables import matched
+from replication.evidence.tables import Compared, matched
 from replication.paths import CONF_DIR, experiment_names
 from replication.runner.config import experiment_at_scale, planned
 from replication.runner.validate import check_conditions, named_conditions
@@ -104,7 +104,7 @@ def test_a_condition_written_as_its_label_is_refused_in_one_line(tmp_path):
                                      'conditions: ["N=10;scene=x"]}'})
     with pytest.raises(ConfigError, match=r"^table 't': match is a list: write 'scene=a' as - "
                                           r"\{ours: \{scene: a\}, paper: \{experiment: a\}\}$"):
-        matched({"name": "t", "match": {"scene=a": {"experiment": "a"}}})
+        matched(Compared(name="t", match={"scene=a": {"experiment": "a"}}))
     with pytest.raises(ConfigError, match=r"^experiment/bis_pf.yaml: figure 'encounters': conditions: write the "
                                           r"condition 'scene=exp2_16_targets' as a mapping, \{scene: exp2_16_targets\}$"):
         check_conditions(_cfg("experiment=bis_pf", 'experiment.report.figures.2.conditions=["scene=exp2_16_targets"]'))

@@ -10,7 +10,9 @@ from scipy import stats
 
 from conftest import typed
 
-from replication.evidence.claims import ClaimTest, Result
+from replication.evidence.checks import Result
+
+from replication.evidence.claim_tests import ClaimTest
 from replication.evidence.comparisons import Effect, order_test
 from replication.evidence.original import PaperRuns, fewest_runs, paper_runs, runs_behind
 from replication.evidence.settings import INFERENCE

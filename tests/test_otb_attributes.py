@@ -14,7 +14,9 @@ from replication.report import figures
 from replication.report.figures import metric as metric_figures, tracking as tracking_figures
 from replication.evidence.tables import TableKind
 from replication.scenes.otb import otb_attributes
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 # Suv carries OCC, IPR and OV; Girl SV, OCC, IPR and OPR (OTB-100's list).  The scene keys are ours.
 EXPERIMENT = {
     "methods": {"A": {"label": "method A"}, "B": {}},
@@ -46,7 +48,7 @@ def hand_records() -> pd.DataFrame:
 
 
 def test_attribute_table_averages_sequences_not_runs():
-    table = TableKind.of({"name": "attributes", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(
+    table = TableKind.of({"name": "attributes", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame(), FOOTAGE).build(
         hand_records())
     frame = table.frame
     rows = {(row["method"], row["attribute"].split()[0]): row for _, row in frame.iterrows()}
@@ -82,7 +84,7 @@ def test_attribute_interval_needs_five_runs_per_sequence_and_keeps_sequences_fix
                        [GOOD] * 4) for r in range(n)]
 
     five = typed(pd.DataFrame(runs("suv", 5, 0) + runs("girl", 5, 1)))
-    occlusion = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(five).frame
+    occlusion = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame(), FOOTAGE).build(five).frame
     occlusion = occlusion[occlusion["attribute"].str.startswith("OCC")].iloc[0]
     estimate = occlusion["precision20"]
     suv, girl = (five[five["condition"].str.contains(s)]["precision20"].mean() for s in ("suv", "girl"))
@@ -90,14 +92,14 @@ def test_attribute_interval_needs_five_runs_per_sequence_and_keeps_sequences_fix
     assert estimate.low < estimate.value < estimate.high and 0.0 <= estimate.low and estimate.high <= 1.0
     assert occlusion["condition"] == "N=10" and occlusion["runs"] == 5 and estimate.runs == 10
     four = typed(pd.DataFrame(runs("suv", 5, 0) + runs("girl", 4, 1)))
-    frame = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(four).frame
+    frame = TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame(), FOOTAGE).build(four).frame
     defined = dict(zip(frame["attribute"].str.split().str[0], frame["precision20"].map(lambda e: e.defined)))
     assert defined == {"SV": False, "OCC": False, "IPR": False, "OPR": False, "OV": True}  # OV: Suv only
 
 
 def test_no_listed_sequence_gives_an_empty_table_and_every_listed_code_is_an_attribute():
     synthetic = typed(pd.DataFrame([record("A", "scene=blob", 0, [0], [0.9])]))
-    assert TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame()).build(synthetic).empty
+    assert TableKind.of({"name": "a", "kind": "otb_attributes"}, EXPERIMENT, pd.DataFrame(), FOOTAGE).build(synthetic).empty
     meanings, sequences = otb_attributes()
     assert list(meanings) == ["IV", "SV", "OCC", "DEF", "MB", "FM", "IPR", "OPR", "OV", "BC", "LR"]
     assert sequences["Suv"] == ["OCC", "IPR", "OV"] and sequences["Jogging-2"] == ["OCC", "DEF", "OPR"]
@@ -105,7 +107,7 @@ def test_no_listed_sequence_gives_an_empty_table_and_every_listed_code_is_an_att
 
 def test_attribute_map_shows_each_method_per_attribute_and_frames_the_best(keep_figures, tmp_path):
     drawn = keep_figures(metric_figures, tracking_figures)
-    figures.draw(hand_records(), {"kind": "attribute_map", "name": "m"}, EXPERIMENT, tmp_path / "m.png")
+    figures.draw(hand_records(), {"kind": "attribute_map", "name": "m"}, EXPERIMENT, tmp_path / "m.png", footage=FOOTAGE)
     precision = drawn[0].axes[0]
     assert [t.get_text() for t in precision.get_xticklabels()] == ["SV\nGirl", "OCC\n2 seq.", "IPR\n2 seq.",
                                                                    "OPR\nGirl", "OV\nSuv"]

@@ -184,10 +184,10 @@ def test_exported_results_rescored_by_the_toolkit(exported, toolkit_otb, monkeyp
 
 
 def test_the_experiment_report_exports_runs_on_otb_sequences(exported):
-    from replication.report.pages.experiment import write_experiment_report
+    from replication.report.experiments import write_experiment
     from replication.runner.results import Results
 
-    page = write_experiment_report(exported.cfg, Results.of(exported.cfg, exported.runs, exported.store))
+    page = write_experiment(exported.cfg, Results.of(exported.cfg, exported.runs, exported.store))
     assert 'href="results/OTB2015/"' in page.read_text() and 'href="results/GOT-10k/"' in page.read_text()
     for layout in ("OTB2015/PF_N=10/Girl.txt", "GOT-10k/PF_N=10/Girl/Girl_002.txt"):
         assert (page.parent / "results" / layout).read_text() == (exported.root / "results" / layout).read_text()

@@ -179,9 +179,10 @@ def test_a_new_filter_is_its_file_its_registration_and_its_yaml_entry(make_cfg, 
     beside the papers' methods, is labelled in the tables and drawn in its look, with no other file changed."""
     from matplotlib.colors import to_hex
 
+    from replication.report.experiments import write_experiment
     from replication.report.figures import draw, metric
-    from replication.report.pages.experiment import write_experiment_report
     from replication.runner.execute import execute
+    from replication.runner.footage import SceneFootage
     from replication.runner.results import Results
     from replication.runner.store import Store
     from replication.runner.validate import prepare
@@ -201,11 +202,11 @@ def test_a_new_filter_is_its_file_its_registration_and_its_yaml_entry(make_cfg, 
     records = results.records
     assert len(records[records["method"] == "Steady"]) == 4 and records["rmse"].notna().all()
     drawn = keep_figures(metric)
-    page = write_experiment_report(cfg, results)
+    page = write_experiment(cfg, results)
     table = (page.parent / "table1_rmse.csv").read_text()
     assert "\nSteady,N=50," in table and "\nPF (bootstrap),-," in table  # its key (no label:)
-    draw(records, {"kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, results.experiment,
-         tmp_path / "rmse.png")
+    draw(records, {"name": "f", "kind": "metric_vs_condition", "metric": "rmse", "x": "N"}, results.experiment,
+         tmp_path / "rmse.png", footage=SceneFootage())
     line = next(line for ax in drawn[-1].axes for c in ax.containers if c.get_label().startswith("Steady")
                 for line in c.lines[:1])
     assert (to_hex(line.get_color()), line.get_linestyle(), line.get_marker()) == ("#f0e442", "-.", "X")

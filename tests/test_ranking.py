@@ -10,10 +10,13 @@ from conftest import typed
 from replication.evidence.verdict import Outcome
 from replication.report import figures
 from replication.report.figures import ranking as ranking_figures
-from replication.evidence.claims import ClaimTest, Result
+from replication.evidence.checks import Result
+from replication.evidence.claim_tests import ClaimTest
 from replication.evidence.ranking import held_out, rank, rankings
 from replication.evidence.tables import Table, TableKind
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 SEQUENCES = [f"s{i}" for i in range(6)]
 
 
@@ -84,15 +87,15 @@ def test_rankings_from_records_pair_runs_and_split_by_a_variable():
     scores = rng.uniform(0.2, 0.8, (6, 5, 2))
     records = pd.concat([_records(scores, ["PF", "ISM-PF"], N=10),
                          _records(scores[:, :, ::-1], ["PF", "ISM-PF"], N=50)])  # the other way round
-    split = rankings(records, {"metric": "precision20", "by": "N"})
+    split = rankings(records, "precision20", by="N")
     assert set(split) == {"N=10", "N=50"}
     ten, fifty = split["N=10"], split["N=50"]
     assert ten.p_best[ten.index("PF")] == fifty.p_best[fifty.index("ISM-PF")]
-    together = rankings(records, {"metric": "precision20"})
+    together = rankings(records, "precision20")
     assert set(together) == {""} and set(together[""].methods) == {"PF (N=10)", "ISM-PF (N=10)", "PF (N=50)",
                                                                   "ISM-PF (N=50)"}
     unpaired = records[~((records["method"] == "PF") & (records["repetition"] == 4))]  # a run PF lacks
-    assert rankings(unpaired, {"metric": "precision20", "by": "N"})["N=10"].runs == 4
+    assert rankings(unpaired, "precision20", by="N")["N=10"].runs == 4
 
 
 EXPERIMENT = {"methods": {"A": {}, "B": {}, "C": {}}}
@@ -143,7 +146,7 @@ def test_ranking_and_pairwise_tables_and_the_figure(tmp_path, keep_figures):
     assert [(order.index(a), order.index(b)) for a, b in zip(pairs.frame["A"], pairs.frame["B"])] == \
         [(0, 1), (0, 2), (1, 2)]
     drawn = keep_figures(ranking_figures)
-    figures.draw(records, {**spec, "title": "t"}, experiment, tmp_path / "r.png")
+    figures.draw(records, {**spec, "title": "t"}, experiment, tmp_path / "r.png", footage=FOOTAGE)
     title = drawn[0].axes[0].get_title(loc="left")
     assert "not reliable" in title and "6 sequences x 1 run(s)" in title
 

@@ -11,14 +11,13 @@ import sys
 from collections import Counter
 
 import numpy as np
-import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 from conftest import PROJECT_ROOT
 
 from replication.errors import ConfigError
-from replication.evidence.curves import CURVES, curve_table
+from replication.evidence.figures import FIGURE_KINDS, figure_spec
 from replication.evidence.published import load_published
 from replication.evidence.tables import TableKind
 from replication.record.manifest import Before, Manifest
@@ -33,7 +32,10 @@ from replication.runner.config import expand, experiment_at_scale
 from replication.runner.execute import execute
 from replication.runner.machine import Machine
 from replication.runner.store import Store
+from replication.runner.curves import CURVES, curve_table
+from replication.runner.footage import SceneFootage
 
+FOOTAGE = SceneFootage()  # the video the runs saw, as the pages are given it
 UNGM = ("scale=paper", "experiment.runs.paper=2", "experiment.model.steps=10")
 # bis_pf's 3123 test at its full length, one run per method: the runs whose strip the modes table reads
 BALLS = ("scale=paper", "experiment.runs.paper=1", "experiment.model.sweep.scene=[exp1_3123]")
@@ -119,18 +121,19 @@ def test_only_the_series_a_table_reads_are_kept_and_its_table_is_the_stores(make
     from_record, from_store = Record(tmp_path / "record").load(runs), store.load(runs)
     spec = next(t for t in experiment["report"]["tables"] if t.get("kind") == "modes")
     published = load_published(str(PROJECT_ROOT.parent / "shared" / "reference" / "published_values.csv"))
-    built = [TableKind.of(spec, experiment, published).build(r).written() for r in (from_record, from_store)]
+    built = [TableKind.of(spec, experiment, published, FOOTAGE).build(r).written() for r in (from_record, from_store)]
     assert built[0].equals(built[1]) and len(built[0])
-    curve = next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve")
+    curve = figure_spec(next(f for f in experiment["report"]["figures"] if f["kind"] == "per_frame_curve"))
     with pytest.raises(NothingToDraw, match="drawn from each run's per_frame, which these records do not hold"):
-        draw(from_record, curve, experiment, tmp_path / "curve.png")
+        draw(from_record, curve, experiment, tmp_path / "curve.png", footage=FOOTAGE)
     kept = Record(tmp_path / "record").curves("bis_pf")  # instead, the curve the figure draws
-    curves = {f["name"] for f in experiment["report"]["figures"] if f["kind"] in CURVES}
-    assert curve["name"] in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
-    table = curve_table(from_store, curve, experiment)
-    assert list(kept[curve["name"]].columns) == list(table.columns) and len(table) > 100
-    assert np.allclose(kept[curve["name"]]["mean"], table["mean"], rtol=1e-6)  # single precision
-    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve["name"]]).exists()
+    curves = {f["name"] for f in experiment["report"]["figures"] if FIGURE_KINDS[f["kind"]].curved}
+    assert curve.name in kept and set(kept) <= curves  # off_image: its scenes (the 16 balls) were not run
+    table = curve_table(from_store, curve, experiment, FOOTAGE)
+    assert list(kept[curve.name].columns) == list(table.columns) and len(table) > 100
+    assert np.allclose(kept[curve.name]["mean"], table["mean"], rtol=1e-6)  # single precision
+    assert draw(from_record, curve, experiment, tmp_path / "curve.png", curve=kept[curve.name],
+                footage=FOOTAGE).exists()
 
 
 def rewritten(path, column, values):
@@ -303,32 +306,43 @@ def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically
 
 
 def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):
+    """Two drawn report folders whose summaries differ in one claim's verdict and one cell's estimate: diff reads
+    what the summaries decide (no claims.csv or summary.csv there) and names both."""
+    from replication.evidence.claims import Check, Result, load_papers
+    from replication.evidence.published import load_published, published_path
+    from replication.evidence.schema import Summary
+    from replication.evidence.statistics import Estimate
+    from replication.evidence.tables import KEYS, CellResult
+    from replication.evidence.verdict import Outcome, Verdict
     from replication.report.diff import main as diff
 
-    claims = pd.DataFrame({"claim_id": ["p.a", "p.b", "p.c"], "verdict": ["holds", "inconclusive", "holds"],
-                           "number": ["1.2 [0.5, 1.9]", "0.1 [-0.3, 0.5]", "3"], "runs": ["10", "10", "10"],
-                           "robustness": ["robust", "robust", "one reading"]})
-    cells = pd.DataFrame({"paper": ["p"], "table": ["1"], "experiment": ["e"], "method": ["PF"], "metric": ["rmse"],
-                          "condition": ["N=100"], "ours": ["4.1 [3.9, 4.3]"], "verdict": ["reproduced"]})
-    for name, (c, s) in {"a": (claims, cells),
-                         "b": (claims.assign(verdict=["holds", "does not hold", "holds"],
-                                             robustness=["robust", "robust", "no reading moves the verdict "]),
-                               cells.assign(ours="4.2 [4.0, 4.4]"))
-                         }.items():
-        (tmp_path / name).mkdir()
-        c.to_csv(tmp_path / name / "claims.csv", index=False)
-        s.to_csv(tmp_path / name / "summary.csv", index=False)
+    paper, claim = next((p, c) for p in load_papers() for c in p.claims if c.id == "ism_pf.accuracy")
+    reading = claim.readings[0]
+    index, cell = next((i, c) for i, c in load_published(str(published_path(None))).iterrows() if c["paper"] == paper.key)
+
+    def summary(outcome: Outcome, ours: float) -> Summary:
+        estimate = Estimate(ours, ours - 0.2, ours + 0.2, 10, "t")
+        check = Check("accuracy", Verdict(outcome, "why"), Estimate(0.5, 0.4, 0.6, 10, "t"))
+        entry = CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name="t", our_method=cell["method"],
+                           our_condition=str(cell["condition"]), runs=10, estimate=estimate,
+                           verdict=Verdict(Outcome.REPRODUCED, "close"))
+        return Summary(reading.experiment, "t", paper.key, "paper", 10, 10, cells=(entry,),
+                       claims={claim.id: {reading.name: Result(Verdict(outcome, "why"), (check,), check)}})
+
+    for name, (outcome, ours) in {"a": (Outcome.REPRODUCED, 4.1), "b": (Outcome.NOT_REPRODUCED, 4.2)}.items():
+        (tmp_path / name / reading.experiment).mkdir(parents=True)
+        summary(outcome, ours).write(tmp_path / name / reading.experiment)
     with pytest.raises(SystemExit) as status:
         diff([str(tmp_path / "a"), str(tmp_path / "b")])
     assert status.value.code == 1  # as diff(1): something differs
     out = capsys.readouterr().out
     assert f"A: {tmp_path / 'a'}: a drawn report, read as it is" in out
-    assert "p.b: verdict 'inconclusive' -> 'does not hold'" in out and "p.a:" not in out
-    assert "p 1 e PF rmse N=100: ours '4.1 [3.9, 4.3]' -> '4.2 [4.0, 4.4]'" in out
-    assert "p.c: robustness 'one reading' -> 'no reading moves the verdict '" in out
-    assert "3 claims: 1 changed verdict, 2 changed at all; 1 cells: 1 changed" in out  # p.c's verdict held
+    assert f"{claim.id}: verdict 'reproduced' -> 'not reproduced'" in out
+    key = " ".join(str(cell[k]) for k in KEYS if str(cell[k]))
+    assert f"{key}: ours '4.1 [3.9, 4.3]' -> '4.2 [4, 4.4]'" in out
+    assert ": 1 changed verdict, 1 changed at all; " in out and " cells: 1 changed" in out
     diff([str(tmp_path / "a"), str(tmp_path / "a")])  # the same: nothing differs, exit status 0
-    assert "3 claims: 0 changed verdict, 0 changed at all; 1 cells: 0 changed" in capsys.readouterr().out
+    assert ": 0 changed verdict, 0 changed at all; " in capsys.readouterr().out
     with pytest.raises(SystemExit) as status:
         diff([str(tmp_path / "a"), str(tmp_path / "nothing")])
     err = capsys.readouterr().err
@@ -367,7 +381,7 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     from omegaconf import OmegaConf
 
     from replication.paths import CONF_DIR
-    from replication.report.pages.multiverse import write_multiverse_report
+    from replication.report.experiments import write_multiverse
     from replication.runner.multiverse import load
 
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
@@ -398,7 +412,7 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     for where, store_of in (("store", None),
                             ("record", lambda name, u: record.universe(multiverse.name, u.name))):
         cfg.reports = str(tmp_path / where)
-        pages.append(write_multiverse_report(cfg, multiverse, (), store_of).parent)
+        pages.append(write_multiverse(cfg, multiverse, (), store_of).parent)
     assert (pages[0] / "cases.csv").read_text() == (pages[1] / "cases.csv").read_text()
     assert {r.grade for r in verify([cfg], record, 4, cheapest=False, n_jobs=2, progress=False).runs} == {
         Grade.IDENTICAL}
@@ -425,3 +439,9 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
         "stored": len(larger_runs) - 1, "read from the record": 0, "to compute": 1}
     cfg.record = str(tmp_path / "record")
     assert multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2).endswith(": 0 runs to compute")
+
+
+def test_every_curved_figure_kind_has_its_curve_table_and_no_other_kind_does():
+    """A figure kind declares that it draws a curve table (``curved``); the table is computed below the report
+    (:data:`replication.runner.curves.CURVES`): the two lists name the same kinds."""
+    assert {name for name, kind in FIGURE_KINDS.items() if kind.curved} == set(CURVES)

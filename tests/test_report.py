@@ -172,7 +172,7 @@ def records():
 
 def test_table_joins_paper_values_and_judges_against_the_floor(published):
     spec = {"name": "t", "title": "t", "paper_table": "1", "metric": "rmse"}
-    table = Comparison(spec, EXPERIMENT, published).build(records())
+    table = Comparison(Comparison.Spec.of(spec, "t"), EXPERIMENT, published).build(records())
     rows = table.frame.set_index("condition")
     assert rows.loc["N=10", "paper"] == 1.5 and rows.loc["N=10", "verdict"].outcome is Outcome.REPRODUCED
     assert rows.loc["N=20", "verdict"].why.startswith("below the Bayes floor")
@@ -191,7 +191,7 @@ def test_unstated_paper_condition_is_mapped(published):
     frame = records().assign(mean_ess=lambda f: np.where(f["condition"] == "N=10", 7.0, np.nan))
     frame.loc[frame["condition"] == "N=10", "mean_ess"] += np.linspace(-0.5, 0.5, 10)
     spec = {"name": "e", "title": "e", "paper_table": "2", "metric": "mean_ess", "paper_condition": "N=10"}
-    table = Comparison(spec, EXPERIMENT, published).build(frame).frame
+    table = Comparison(Comparison.Spec.of(spec, "t"), EXPERIMENT, published).build(frame).frame
     assert list(table["condition"]) == ["N=10"]  # rows with no finite value are dropped
     assert table["paper"].iloc[0] == 7.0 and table["verdict"].iloc[0].outcome is Outcome.REPRODUCED
 
@@ -222,8 +222,8 @@ def test_two_mode_share_counts_frames_with_mass_near_both_hypotheses():
 
 
 def test_scale_changes_lists_what_quick_changes_from_the_config():
-    from replication.report.pages.scale import scale_changes, scale_note
-    from replication.scales import at_scale
+    from replication.report.pages.scale import scale_note
+    from replication.scales import at_scale, scale_changes
 
     config = {"quick_frames": {"paper": None, "quick": 100},  # a YAML anchor, not a setting
               "runs": {"paper": 100, "quick": 10},
@@ -240,9 +240,9 @@ def test_the_quick_banner_of_a_users_own_sequences_lists_them_not_the_shipped_on
     not the six shipped sequences it replaced."""
     from conftest import PROJECT_ROOT
 
-    from replication.report.pages.scale import scale_changes
     from replication.runner.results import Results
     from replication.runner.store import Store
+    from replication.scales import scale_changes
     from replication.scenes.otb import OTB_ROOT
 
     girl = PROJECT_ROOT / OTB_ROOT / "Girl"

@@ -11,7 +11,7 @@ import yaml
 from conftest import PROJECT_ROOT
 from replication.evidence.schema import Summary
 from replication.paths import CONF_DIR
-from replication.report.pages.experiment import write_experiment_report
+from replication.report.experiments import write_experiment
 from replication.report.pages.index import write_index
 from replication.runner.config import expand
 from replication.runner.execute import execute
@@ -37,7 +37,7 @@ def test_both_scales_pages_stay_and_the_scorecard_names_each_verdicts_scale(make
         cfg = make_cfg("hspf_ungm", f"scale={scale}", f"experiment.runs.{scale}={runs}")
         store = Store(tmp_path / "experiments", "hspf_ungm")
         execute(expand(cfg), store, n_jobs=1, progress=False)
-        write_experiment_report(cfg, Results.of(cfg, expand(cfg), store))
+        write_experiment(cfg, Results.of(cfg, expand(cfg), store))
     paper, quick = (Summary.read(report_folder(reports, "hspf_ungm", scale) / "summary.json") for scale in SCALES)
     assert (paper.scale, paper.n_runs, quick.scale, quick.n_runs) == ("paper", 15, "quick", 6)
     assert report_folder(reports, "hspf_ungm", "quick") == reports / "quick" / "hspf_ungm"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from replication.errors import ConfigError
-from replication.evidence.claims import Check, Result
+from replication.evidence.checks import Check, Result
 from replication.evidence.schema import RobustnessResult, Summary, dump, load
 from replication.evidence.settings import INFERENCE, configure, rules
 from replication.evidence.statistics import Estimate

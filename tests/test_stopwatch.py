@@ -33,3 +33,29 @@ def test_the_manifest_sums_cpu_time_and_takes_the_median_and_largest_load():
     assert _summed(rows, "cpu_s") == 3.8  # 3.75 rounded to 0.1 s
     assert _load(rows) == (2.0, 7.0)
     assert _summed([{}], "cpu_s") is None and _load([{}]) is None
+
+
+def test_every_time_a_run_records_is_left_out_of_the_determinism_checks():
+    """A run's numbers are compared across jobs, resumptions and machines without its times (which no two
+    computations share): every machine-dependent quantity a run records is a timing column."""
+    from replication.evidence.quantities import QUANTITIES
+    from replication.runner.execute import TIMING_COLUMNS
+
+    published_only = {"time", "run_time", "time_per_frame"}  # the papers' names for their tables' cells
+    timed = {name for name, q in QUANTITIES.items() if q.machine_dependent} - published_only
+    assert timed <= set(TIMING_COLUMNS), timed - set(TIMING_COLUMNS)
+    assert {"cpu_s", "cpu_ms_per_frame", "cpu_ms_per_step", "cpu_filter_s", "load_1m"} <= set(TIMING_COLUMNS)
+
+
+def test_the_reference_work_is_timed_once_per_interval_and_again_after_it(monkeypatch):
+    from replication import stopwatch
+
+    assert stopwatch.reference_ms(repeats=1) > 0
+    measured, clock = [], [100.0]
+    monkeypatch.setattr(stopwatch.time, "monotonic", lambda: clock[0])
+    every = stopwatch._Every(lambda: measured.append(clock[0]) or float(len(measured)), 60.0)
+    assert every() == 1.0 and every() == 1.0  # the first call measures, the next within a minute reuses it
+    clock[0] += 59.9
+    assert every() == 1.0
+    clock[0] += 0.1
+    assert every() == 2.0 and measured == [100.0, 160.0]

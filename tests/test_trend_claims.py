@@ -7,7 +7,8 @@ import pytest
 from scipy import stats
 
 from conftest import typed
-from replication.evidence.claims import ClaimTest, Result
+from replication.evidence.checks import Result
+from replication.evidence.claim_tests import ClaimTest
 from replication.evidence.trends import dominance, log_log_slope
 from replication.evidence.settings import INFERENCE
 from replication.evidence.verdict import Outcome

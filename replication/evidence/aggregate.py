@@ -5,7 +5,6 @@ import pandas as pd
 from replication.condition import PREFIX, values_of
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import estimate
-from replication.scenes.factory import cached_sequence
 
 
 def scene_of(experiment: dict, records: pd.DataFrame) -> str:
@@ -13,15 +12,6 @@ def scene_of(experiment: dict, records: pd.DataFrame) -> str:
     scene."""
     scene = values_of(records, "scene").iloc[0] if len(records) else None
     return scene or experiment["model"]["scene"]
-
-
-def sequence_seen(experiment: dict, runs: pd.DataFrame):
-    """The video the first repetition of ``runs`` (one condition) saw: its scene at the run's own seed where
-    each run has its own video (``scene_seed``), else as configured; every method at that repetition saw it."""
-    first = runs.sort_values("repetition").iloc[0]
-    scene = experiment["scenes"][scene_of(experiment, runs)]
-    seed = first.get("scene_seed")
-    return cached_sequence(scene if seed is None or pd.isna(seed) else {**scene, "seed": int(seed)})
 
 
 def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic: str = "mean") -> pd.DataFrame:

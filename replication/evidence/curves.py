@@ -1,27 +1,17 @@
-"""Curves over frames and thresholds as tidy tables: what the report's curve figures draw, computed from
-the runs' per-frame series, and what the paper-scale record keeps in place of the series.
-
-Each is registered under the figure kind that draws it (:data:`CURVES`); it takes the runs (a records
-table with ``per_frame``), the figure's spec and the experiment, and gives one row per point of a line,
-in the order the lines are drawn (conditions, then methods, as the runs come).  :func:`curve_table` is
-the table of one figure spec.
-"""
-
-from collections.abc import Callable
+"""How a curve figure picks its runs and where it cuts a diverged one: the rules the figures and the curve
+tables (:mod:`replication.runner.curves`, computed below the report from the runs' per-frame series) share."""
 
 import numpy as np
 import pandas as pd
 
-from replication.evidence.aggregate import sequence_seen
 from replication.evidence.named_conditions import as_mappings, matching
-from replication.metrics import tracking as tm
 
 
-def clip_level(spec: dict, typical: float) -> float | None:
+def clip_level(clip: float | None, typical: float) -> float | None:
     """Where a diverged run is cut: the figure's ``clip:``, else 10 times the typical magnitude given
     (none when that is 0 or unknown)."""
-    if spec.get("clip") is not None:
-        return float(spec["clip"])
+    if clip is not None:
+        return float(clip)
     level = 10 * abs(typical)
     return level if np.isfinite(level) and level > 0 else None
 
@@ -38,97 +28,12 @@ def clip_diverged(values, level: float | None) -> tuple[np.ndarray, np.ndarray]:
     return np.where(bad, edge, values), diverged
 
 
-CURVES: dict[str, Callable[[pd.DataFrame, dict, dict], pd.DataFrame]] = {}  # figure kind -> its table
-
-
-def curve(kind: str) -> Callable:
-    """Register the decorated function as the table the figure kind ``kind`` draws."""
-    def register(table: Callable) -> Callable:
-        CURVES[kind] = table
-        return table
-    return register
-
-
-def curve_table(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
-    """The table figure ``spec`` (a kind in :data:`CURVES`) draws, from the runs of its ``conditions``
-    (all, if it names none); empty if none of them was run."""
-    if "conditions" in spec:
-        records = records[figure_runs(records, spec)]
-    return CURVES[spec["kind"]](records, spec, experiment) if len(records) else pd.DataFrame()
-
-
-def figure_conditions(spec: dict) -> list[dict]:
+def figure_conditions(spec) -> list[dict]:
     """The ``conditions`` figure ``spec`` is drawn at, each a mapping of values
     (:mod:`~replication.evidence.named_conditions`); none: every condition."""
-    return as_mappings(spec.get("conditions"), f"figure {spec.get('name', spec.get('kind'))!r}: conditions")
+    return as_mappings(spec.conditions, f"figure {spec.name!r}: conditions")
 
 
-def figure_runs(records: pd.DataFrame, spec: dict) -> pd.Series:
+def figure_runs(records: pd.DataFrame, spec) -> pd.Series:
     """Which of ``records`` figure ``spec`` draws, where it names ``conditions``: the runs at one of them."""
     return matching(records, *figure_conditions(spec))
-
-
-@curve("per_frame_curve")
-def per_frame_band(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
-    """Per condition, method and frame, the mean and 10-90 % band over runs of the per-frame series
-    ``spec.series`` (a run diverged beyond the condition's :func:`clip_level` is clipped, and counted in
-    ``diverged``); frames no run estimates and methods that do not record the series are left out."""
-    rows = []
-    for condition, group in records.groupby("condition", sort=False):
-        curves = _per_frame(group, spec["series"])
-        typical = max((np.nanmax(np.nanmedian(np.abs(v), axis=0)) for _, v in curves.values()), default=np.nan)
-        level = clip_level(spec, typical)
-        for method, (frames, values) in curves.items():
-            values, diverged = clip_diverged(values, level)
-            low, high = np.nanpercentile(values, [10, 90], axis=0)
-            rows.append(pd.DataFrame({"condition": condition, "method": method, "frame": frames,
-                                      "mean": np.nanmean(values, axis=0), "low": low, "high": high,
-                                      "runs": len(diverged), "diverged": int(diverged.sum())}))
-    return pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(
-        columns=["condition", "method", "frame", "mean", "low", "high", "runs", "diverged"])
-
-
-@curve("otb_curves")
-def otb_curves(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
-    """OTB's one-pass precision and success curves per method: each the mean over runs of the run's curve
-    (over the frames :func:`~replication.metrics.tracking.scored_frames` counts), with ``score`` the mean
-    precision at 20 px or success AUC (the legend's number)."""
-    rows = []
-    for method, runs in records.groupby("method", sort=False):
-        errors = [tm.scored_frames(np.asarray(r["cle"], dtype=float)) for r in runs["per_frame"]]
-        overlaps = [tm.scored_frames(np.asarray(r["iou"], dtype=float)) for r in runs["per_frame"]]
-        for curve, thresholds, values, score in (
-                ("precision", tm.PRECISION_THRESHOLDS, np.mean([tm.precision_curve(e) for e in errors], axis=0),
-                 np.mean([tm.precision_at(e) for e in errors])),
-                ("success", tm.SUCCESS_THRESHOLDS, np.mean([tm.success_curve(o) for o in overlaps], axis=0),
-                 np.mean([tm.success_auc(o) for o in overlaps]))):
-            rows.append(pd.DataFrame({"method": method, "curve": curve, "threshold": thresholds.astype(float),
-                                      "value": values, "score": score}))
-    return pd.concat(rows, ignore_index=True)
-
-
-@curve("outside_curve")
-def outside_share(records: pd.DataFrame, spec: dict, experiment: dict) -> pd.DataFrame:
-    """Per method and frame, the share of estimated centres outside the image (the filter's own state),
-    over runs and targets."""
-    size = sequence_seen(experiment, records).size
-    rows = []
-    for method, runs in records.groupby("method", sort=False):
-        outside = tm.outside_image(np.array([r["box"] for r in runs["per_frame"]], dtype=float), size)
-        rows.append(pd.DataFrame({"method": method, "frame": np.arange(outside.shape[1]),
-                                  "share": outside.mean(axis=(0, 2))}))
-    return pd.concat(rows, ignore_index=True)
-
-
-def _per_frame(group: pd.DataFrame, series: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each method's frames (1-based) and runs x frames values of a per-frame series, without the frames
-    no run estimates (the given first one); methods that do not record it (alpha_k: fusion filters
-    only) are left out."""
-    curves = {}
-    for method, runs in group.groupby("method", sort=False):
-        if series not in runs["per_frame"].iloc[0]:
-            continue
-        values = np.array([r[series] for r in runs["per_frame"]], dtype=float)
-        kept = ~np.isnan(values).all(axis=0)
-        curves[method] = (np.arange(1, values.shape[1] + 1)[kept], values[:, kept])
-    return curves

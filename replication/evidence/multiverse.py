@@ -7,7 +7,9 @@ from functools import cached_property
 
 import numpy as np
 
-from replication.evidence.claims import Check, Claim, Result
+from replication.evidence.checks import Check, Result
+
+from replication.evidence.claims import Claim
 from replication.evidence.inference import said_p
 from replication.evidence.robustness import DECISIVE, ChoiceEffect, Pairing, adjust, paired_effect
 from replication.evidence.schema import RobustnessResult
@@ -80,7 +82,7 @@ class Robustness:
         Sobol points, the default case), and how many of its cases' verdicts differ from the twin's.  A
         scoring reading, and a statistic with no per-run values (a published cell, a ranking), count only
         conflicting decisive verdicts (reproduced against not reproduced), and so does a time (a deciding check
-        :attr:`~replication.evidence.claims.Check.timed`: load, not the reading, may move it).  A reading at
+        :attr:`~replication.evidence.checks.Check.timed`: load, not the reading, may move it).  A reading at
         equal cost is an alternative of :data:`BASIS` (its twin: the same universe scored by the default
         reading), not of :data:`READING`, whose alternatives are the readings at equal N."""
         testable = self.testable

@@ -1,8 +1,9 @@
 """What each per-run metric is: its range, which way is better, its interval, its human label.
 
 A record's metric names are the compute side's (``rmse``,
-``correct_frames[iou>=0.5]``); this is the one place the report says what
-kind of number each is, so that an interval fits its quantity:
+``correct_frames[iou>=0.5]``); this is the one place that names and labels them (tables, claims and the
+figures' axes: :func:`label`) and reads a ``metric[rule]`` name, and says what kind of number each is, so
+that an interval fits its quantity:
 
 * ``binary``: a per-run yes/no outcome (a run failed, a target was tracked to
   the end); its mean over runs is a proportion: Clopper-Pearson interval.
@@ -98,6 +99,7 @@ QUANTITIES = {
     "wall_s": Quantity("timing", label="wall time (s)"),
     "cpu_s": Quantity("timing", label="CPU time (s)"),
     "load_1m": Quantity("positive", label="machine load (1-minute average)"),
+    "reference_ms": Quantity("timing", label="reference work (ms): the machine's speed"),
     "fps": Quantity("timing", lower_is_better=False, label="frames per second"),
     # the papers' own names for what their tables print (a published cell's metric)
     "time": Quantity("timing", label="time per step (ms)"),
@@ -108,10 +110,17 @@ QUANTITIES = {
                                       label="correct tracking rate (%)"),
     "improvement": Quantity("real", -math.inf, math.inf, lower_is_better=False, label="improvement (%)"),
 }
+RULES = {  # a rule in a metric's name, in words
+    "iou>=0.5": "IoU ≥ 0.5",
+    "iou>0": "IoU > 0",
+    "cle<=20": "centre error ≤ 20 px",
+    "cle<=10": "centre error ≤ 10 px",
+}
 _PATTERNS = (  # metrics named after a rule: correct_frames[iou>=0.5], tracked_to_end[cle<=20]
-    (re.compile(r"correct_frames\[(.+)\]"), lambda rule: replace(_SHARE, label=f"share of frames with {rule}")),
+    (re.compile(r"correct_frames\[(.+)\]"),
+     lambda rule: replace(_SHARE, label=f"share of frames with {RULES.get(rule, rule)}")),
     (re.compile(r"tracked_to_end\[(.+)\]"), lambda rule: replace(_BINARY, lower_is_better=False,
-                                                                 label=f"runs tracked to the end ({rule})")),
+                                                                 label=f"runs tracked to the end ({RULES.get(rule, rule)})")),
     (re.compile(r"ospa\[c=(.+)\]"), lambda cutoff: Quantity("positive", label=f"OSPA, cut off at {cutoff} px")),
     (re.compile(r"failed\[(.+)\]"), lambda reading: replace(_BINARY, label=f"runs failed ({reading})")),
     (re.compile(r"error_without_failure\[(.+)\]"),
@@ -130,3 +139,11 @@ def quantity(metric: str) -> Quantity:
             return make(found[1])
     raise ConfigError(f"unknown metric {metric!r}: declare what it is (range, which way is better) in "
                       f"replication/evidence/quantities.py; known: {', '.join(sorted(QUANTITIES))}")
+
+
+def label(metric: str) -> str | None:
+    """A metric's words (its quantity's label); None for a name that is no metric declared here."""
+    try:
+        return quantity(metric).label or None
+    except ConfigError:
+        return None

@@ -178,16 +178,15 @@ def rank(scores: np.ndarray, methods, sequences, lower_is_better: bool) -> Ranki
                    rank_probability[order], beats[np.ix_(order, order)], means[:, order])
 
 
-def rankings(records: pd.DataFrame, spec: dict) -> dict[str, Ranking]:
-    """The rankings a table, figure or claim ``spec`` asks for: the methods in ``records`` by mean
-    ``metric`` over the values of the condition variable ``over`` (the sequences; default ``scene``), one
-    ranking per value of the variable ``by`` if given (keyed 'N=10'; '' without ``by``).
+def rankings(records: pd.DataFrame, metric: str, over: str = "scene", by: str | None = None) -> dict[str, Ranking]:
+    """The rankings a table, figure or claim asks for: the methods in ``records`` by mean ``metric`` over the
+    values of the condition variable ``over`` (the sequences), one ranking per value of the variable ``by`` if
+    given (keyed 'N=10'; '' without ``by``).
 
     A method run at several values of another variable is one entry per value ('PF (N=300)').  Only
     repetitions every entry ran on every sequence are kept (the pairing); a metric an entry does not
     have leaves it out; a group of fewer than two entries is no ranking.
     """
-    metric, over, by = spec["metric"], spec.get("over", "scene"), spec.get("by")
     rest = label_of(records, without=(over, by))
     frame = pd.DataFrame({
         "group": [f"{by}={value}" if value is not None else "" for value in values_of(records, by)],

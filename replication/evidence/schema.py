@@ -1,7 +1,7 @@
 """What a report stores in its ``summary.json``, as typed values, and the one serialiser that writes and reads them.
 
 A page builds a :class:`Summary` (its published cells as :class:`CellResult`, its claims' readings as
-:class:`~replication.evidence.claims.Result`, a multiverse's claims as :class:`RobustnessResult`);
+:class:`~replication.evidence.checks.Result`, a multiverse's claims as :class:`RobustnessResult`);
 :func:`dump` turns any such value into JSON and :func:`load` rebuilds it from its type hints, so the
 index, the scorecard and the PDF read the values a page decided, never text parsed back.
 """
@@ -16,7 +16,7 @@ from enum import Enum
 from pathlib import Path
 
 from replication import atomic
-from replication.evidence.claims import Result
+from replication.evidence.checks import Result
 from replication.evidence.tables import CellResult
 from replication.evidence.verdict import Verdict
 

@@ -15,8 +15,10 @@ import pandas as pd
 
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
-from replication.evidence.claims import Check, Claim, Paper, Reading
+from replication.evidence.checks import Check
+from replication.evidence.claims import Claim, Paper, Reading
 from replication.evidence.schema import RobustnessResult, Summary
+from replication.evidence.summary import experiment_configs, summary_table
 
 
 @dataclass(frozen=True)
@@ -176,3 +178,31 @@ def _across(row: ClaimRow) -> dict:
     return {"cases": stored.cases, "flipped_by": "; ".join(stored.flipped_by), "best_case": stored.best_case,
             "best_case_verdict": stored.best_case_verdict.outcome.value, "best_case_number": stored.best_case_number,
             "multiverse": row.multiverse_experiment}
+
+
+@dataclass(frozen=True)
+class Scorecard:
+    """What the summaries of a reports folder decide together, read once through their schema: each paper's
+    claims (``rows``), the summary of every published cell (``cells``, with the claim owning each and a link),
+    each claim's tally of its cells and the claims as one table (``claims``); ``reports/summary.csv`` and
+    ``reports/claims.csv`` are its exports (:attr:`cell_table`, :attr:`claims`), never read back."""
+
+    summaries: dict[str, Summary]
+    rows: dict[str, list[ClaimRow]]
+    cells: pd.DataFrame
+    tallies: dict[str, str]
+    claims: pd.DataFrame
+
+    @classmethod
+    def of(cls, summaries: dict[str, Summary], papers: list[Paper], published: pd.DataFrame) -> "Scorecard":
+        """The scorecard of ``summaries`` (:func:`~replication.evidence.summary.load_summaries`), judged
+        against the ``published`` values."""
+        rows = claim_rows(papers, summaries)
+        cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
+        tallies = cell_tallies(cells)
+        return cls(summaries, rows, cells, tallies, claims_frame(rows, cells, tallies))
+
+    @property
+    def cell_table(self) -> pd.DataFrame:
+        """The summary of every published cell as ``summary.csv`` writes it (without the link's text)."""
+        return self.cells.drop(columns=["link_text"])

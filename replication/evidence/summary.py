@@ -19,7 +19,7 @@ import pandas as pd
 import yaml
 
 from replication.evidence.schema import Summary
-from replication.evidence.tables import KEYS, CellResult, matched
+from replication.evidence.tables import KEYS, CellResult, Compared, matched, table_specs
 from replication.paths import CONF_DIR, experiment_names
 from replication.scales import SCALES, page_link, report_folder
 
@@ -173,19 +173,15 @@ def _scene_notes(published: pd.DataFrame) -> dict[tuple, str]:
     return notes
 
 
-def _as_list(value) -> list[str]:
-    return [] if value is None else [str(v) for v in value] if isinstance(value, list) else [str(value)]
-
-
-def _covering(cell: pd.Series, configs: dict[str, dict]) -> list[tuple[str, dict]]:
+def _covering(cell: pd.Series, configs: dict[str, dict]) -> list[tuple[str, Compared]]:
     """(experiment, table spec) of each table of ours that compares with the cell's paper table and metric."""
     found = []
     for name, config in configs.items():
         if str(config.get("paper", "")) != cell["paper"]:
             continue
-        for spec in config.get("report", {}).get("tables", []):
-            if str(cell["table"]) in _as_list(spec.get("paper_table")) and \
-                    spec.get("paper_metric", spec.get("metric")) == cell["metric"]:
+        for spec in table_specs(config):
+            if isinstance(spec, Compared) and str(cell["table"]) in spec.paper_tables and \
+                    spec.published_metric == cell["metric"]:
                 found.append((name, spec))
     return found
 
@@ -222,7 +218,7 @@ def _why_not(cell: pd.Series, summaries: dict, configs: dict, scene_notes: dict)
         what = "private video, no stand-in" if private else "scene not reproduced"
         return Unmatched(what, f"{cell['experiment']}{f' ({note})' if note else ''}"), name
     conditions = {str(m["condition"]) for m in wanted if "condition" in m}
-    stated = cell["condition"] or spec.get("paper_condition", "")
+    stated = cell["condition"] or spec.paper_condition
     if conditions and stated not in conditions:
         return Unmatched("condition not reproduced", stated or "unstated"), name
     if name not in summaries:

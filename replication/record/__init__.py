@@ -8,7 +8,7 @@ Layout (``record/`` in a clone, the ``record`` setting of ``conf/config.yaml``):
                                        SHA-256 of every file below
     record/<experiment>/runs.parquet   one row per run (failed runs too, with their ``failure``)
     record/<experiment>/curves/<figure>.parquet   what each curve figure draws (per-frame means and
-                                       bands, OTB curves: :mod:`replication.evidence.curves`)
+                                       bands, OTB curves: :mod:`replication.runner.curves`)
 
 A runs table (:mod:`.runs`) holds a run's identity (``experiment``, ``method``, ``repetition``,
 ``run_key``, ``base_seed``), each condition variable (``condition.N``, ``condition.scene``) and each

@@ -4,9 +4,16 @@ store holds (``make replicate SCALE=paper``, ``make readings SCALE=paper``), the
 line; or of those named, each of which must have all its runs stored."""
 
 import sys
+from dataclasses import dataclass
 
+from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.paths import experiment_names
+
+
+@dataclass(frozen=True)
+class Options:
+    experiment: tuple[str, ...] | None = None  # every experiment whose runs the store holds by default
 
 
 def main(argv: list[str]) -> None:
@@ -18,12 +25,9 @@ def main(argv: list[str]) -> None:
     from replication.paths import CONF_DIR, resolve
     from replication.record.write import SCALE, write
 
-    chosen = [a.split("=", 1)[1].split(",") for a in argv if a.startswith("experiment=")]
-    overrides = [a for a in argv if not a.startswith("experiment=")]
-    wrong = [a for a in overrides if a.partition("=")[0] not in ("store", "record")]
-    if wrong:
-        fail(f"record takes experiment=, store= and record=; got {wrong[0]!r}")
-    names = chosen[-1] if chosen else experiment_names()
+    options, overrides = read(argv, Options, "record", handed=("store", "record"))
+    chosen = options.experiment is not None
+    names = options.experiment if chosen else experiment_names()
     unknown = sorted(set(names) - set(experiment_names()))
     if unknown:
         fail(f"unknown experiment {unknown[0]!r}; known: {', '.join(experiment_names())}")

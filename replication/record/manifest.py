@@ -56,10 +56,12 @@ class Entry:
     universes: int = 0  # a multiverse's universes recorded (0: an experiment)
     before: Before | None = None  # the recording this entry replaced
     machine_details: tuple[Machine, ...] | None = None  # the code paths of its runs' machines (None: not recorded)
-    # summed over the runs: each run's thread CPU time; and the machine's 1-minute load as they ended, median and
-    # max (None: runs recorded before they said)
+    # summed over the runs: each run's thread CPU time; the machine's 1-minute load as they ended, median and
+    # max; the median time of the reference work on their workers (stopwatch.reference_ms: the machine's speed)
+    # (None: runs recorded before they said)
     cpu_s: float | None = None
     load_1m: tuple[float, float] | None = None
+    reference_ms: float | None = None
 
     @property
     def minutes(self) -> float | None:
@@ -97,7 +99,8 @@ class Entry:
             libraries=tuple(sorted({", ".join(f"{k.removesuffix('_version')} {r.get(k)}" for k in LIBRARIES)
                                     for r in rows if not r.get("failure")})),
             machines=_distinct(rows, "machine"), written=datetime.date.today().isoformat(), universes=universes,
-            machine_details=_machines(rows), cpu_s=_summed(distinct, "cpu_s"), load_1m=_load(rows))
+            machine_details=_machines(rows), cpu_s=_summed(distinct, "cpu_s"), load_1m=_load(rows),
+            reference_ms=_median(rows, "reference_ms"))
 
 
 @dataclass(frozen=True)
@@ -167,6 +170,12 @@ def _summed(rows, key: str) -> float | None:
     """The sum of ``key`` over ``rows`` (None where no row has it)."""
     values = [r[key] for r in rows if r.get(key) is not None]
     return round(sum(values), 1) if values else None
+
+
+def _median(rows: list[dict], key: str) -> float | None:
+    """The median of ``key`` over the rows that have it (None where none does)."""
+    values = sorted(r[key] for r in rows if r.get(key) is not None)
+    return values[len(values) // 2] if values else None
 
 
 def _load(rows: list[dict]) -> tuple[float, float] | None:

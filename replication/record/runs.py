@@ -25,7 +25,7 @@ from replication.run import Run
 from replication.runner.results import SERIES, parameters
 
 RUNS_FILE = "runs.parquet"
-CURVES_DIR = "curves"  # <experiment>/curves/<figure>.parquet: what a curve figure draws (evidence.curves)
+CURVES_DIR = "curves"  # <experiment>/curves/<figure>.parquet: what a curve figure draws (runner.curves)
 UNIVERSES_DIR = "universes"  # <multiverse>/universes/<universe>.parquet: a universe's runs of each experiment
 JSON_COLUMNS = b"json_columns"
 FAILURE = "failure"  # a failed run's reason (None for a run with a record)

@@ -54,6 +54,7 @@ from tqdm.auto import tqdm
 
 from replication import atomic
 from replication.condition import PREFIX
+from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.evidence.statistics import Estimate
 from replication.record.manifest import LIBRARIES, PAGES, RECOMPUTED, Manifest
@@ -68,12 +69,25 @@ from replication.runner.store import Store
 
 NOT_COMPARED = (*TIMING_COLUMNS, *LIBRARIES, "code_digest", "git_commit", "git_dirty", "machine", "machine_detail",
                 "replication_version", "experiment", "method", "repetition", "run_key", "base_seed")
-SETTINGS = ("N", "experiment", "cheapest", "n_jobs", "progress", "against", "scale", "store", "reports", "record")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The command's own settings (store=, reports=, record= and experiment.* compose the config)."""
+
+    N: str = "200"  # a number of recorded runs, or all
+    experiment: tuple[str, ...] | None = None  # every experiment the record holds by default
+    cheapest: bool = False
+    n_jobs: int = 2
+    progress: bool = True
+    against: str | None = None
+    scale: str = "paper"
+
+
 SAMPLE_SEED = 20261126  # the sample's own stream: the same N gives the same runs
 LEVEL = 0.99  # a diverged run's columns against its cell's recorded runs: the prediction interval's level
 START = 5.0  # seconds per experiment re-computed, beside its runs' own: loading its scenes and compiled kernels
 DRAW = (10.0, 0.0025)  # seconds to judge an experiment's or multiverse's verdicts: fixed, and per recorded run
-
 
 
 def prediction(values, level: float) -> Estimate:
@@ -447,17 +461,14 @@ def main(argv: list[str], verdicts: Callable[[Path, Path, list[str], int], list[
 
     from replication.paths import CONF_DIR, resolve
 
-    changes = [arg for arg in argv if arg.lstrip("+~").startswith("experiment.")]  # the experiments' own settings
-    options = dict(arg.partition("=")[::2] for arg in argv if arg not in changes)
-    unknown = sorted(set(options) - set(SETTINGS))
-    if unknown:
-        fail(f"unknown setting {unknown[0]!r}; verify takes {', '.join(f'{k}=' for k in SETTINGS)}")
+    options, handed = read(argv, Settings, "verify", handed=("store", "reports", "record", "experiment."))
+    changes = [arg for arg in handed if arg.lstrip("+~").startswith("experiment.")]  # the experiments' own settings
+    paths = [arg for arg in handed if arg not in changes]
     try:
-        n = None if options.get("N", "200") == "all" else _positive(options.get("N", "200"), "N")
-        n_jobs = _positive(options.get("n_jobs", "2"), "n_jobs")
+        n = None if options.N == "all" else _positive(options.N, "N")
+        n_jobs = _positive(str(options.n_jobs), "n_jobs")
     except ValueError as error:
         fail(f"verify: {error}")
-    paths = [f"{k}={options[k]}" for k in ("store", "reports", "record") if k in options]
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose("config", overrides=paths)
         folder = resolve(cfg.record)
@@ -467,26 +478,26 @@ def main(argv: list[str], verdicts: Callable[[Path, Path, list[str], int], list[
         damaged = manifest.damaged(folder)
         if damaged:
             fail(f"{folder}: {', '.join(damaged)} no longer match the manifest's SHA-256")
-        names = options["experiment"].split(",") if options.get("experiment") else sorted(manifest.experiments)
+        names = options.experiment or sorted(manifest.experiments)
         missing = sorted(set(names) - set(manifest.experiments))
         if missing:
             fail(f"the record holds no {missing[0]!r}; it holds {', '.join(sorted(manifest.experiments))}")
-        if options.get("against") is None:
+        if options.against is None:
             print(sampling(manifest, names, n), flush=True)
-        scale = options.get("scale", "paper")
+        scale = options.scale
         cfgs = [compose("config", overrides=[f"experiment={name}", f"scale={scale}", *paths, *changes])
                 for name in names]
     touched = set(names) | {name for name, entry in manifest.experiments.items() if entry.universes}  # may hold them
     judging = 2 * sum(DRAW[0] + DRAW[1] * manifest.experiments[name].runs for name in touched) / n_jobs
     then = f", then up to about {duration(judging)} judging the verdicts again where a run is not identical"
     try:
-        if options.get("against") == "store":  # the store's runs that are recorded ones, graded
+        if options.against == "store":  # the store's runs that are recorded ones, graded
             found = recomputed(cfgs, resolve(cfg.store), Record(folder))
             return write_recomputed(found, resolve(cfg.reports) / PAGES / RECOMPUTED)
-        elif "against" in options:
-            fail(f"against= takes store (compare the store's runs with the record), got {options['against']!r}")
-        verification = verify(cfgs, Record(folder), n, options.get("cheapest", "false") == "true", n_jobs,
-                              progress=options.get("progress", "true") == "true", then=then if verdicts else "")
+        elif options.against is not None:
+            fail(f"against= takes store (compare the store's runs with the record), got {options.against!r}")
+        verification = verify(cfgs, Record(folder), n, options.cheapest, n_jobs, progress=options.progress,
+                              then=then if verdicts else "")
     except ConfigError as error:
         fail(str(error))
     print(machines(verification))

@@ -24,8 +24,8 @@ import pyarrow as pa
 from omegaconf import DictConfig
 
 from replication.errors import ConfigError
-from replication.evidence.curves import CURVES, curve_table
-from replication.evidence.tables import TableKind
+from replication.evidence.figures import figure_specs
+from replication.evidence.tables import TABLE_KINDS, table_specs
 from replication.record.layer import SCALE, checked
 from replication.record.manifest import Entry, Manifest
 from replication.record.runs import (
@@ -33,14 +33,15 @@ from replication.record.runs import (
 )
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
+from replication.runner.curves import curve_table
+from replication.runner.footage import SceneFootage
 from replication.runner.multiverse import load
 from replication.runner.store import CorruptRecord, Store
 
 
 def kept_series(experiment: dict) -> tuple[str, ...]:
     """The per-frame series the experiment's tables are built from: the record keeps those alone."""
-    tables = experiment.get("report", {}).get("tables", [])
-    return tuple(sorted({s for spec in tables for s in TableKind.of(spec, experiment, None).reads}))
+    return tuple(sorted({s for spec in table_specs(experiment) for s in TABLE_KINDS[spec.kind].reads}))
 
 
 def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...],
@@ -84,7 +85,7 @@ def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
     _complete(name, missing, len(runs))
     if from_record == len(runs):  # nothing new in the store: as recorded
         return Manifest.read(record).experiments[name]
-    curved = [spec["name"] for spec in experiment.get("report", {}).get("figures", []) if spec["kind"] in CURVES]
+    curved = [spec.name for spec in figure_specs(experiment) if spec.curved]
     if from_record and curved:
         raise ConfigError(f"{name}: {from_record} of {len(runs)} runs are in the record only, which keeps no per-frame "
                           f"series for its curve figure {curved[0]!r}; compute them to record it: "
@@ -139,19 +140,19 @@ def _complete(name: str, missing: int, total: int) -> None:
 
 
 def write_curves(experiment: dict, store: Store, runs: list[Run], folder: Path) -> list[Path]:
-    """The table of each of the experiment's curve figures (:mod:`replication.evidence.curves`), from the
+    """The table of each of the experiment's curve figures (:mod:`replication.runner.curves`), from the
     runs' per-frame series in ``store`` (read only for an experiment with such a figure), as
     ``<folder>/<figure>.parquet`` (floats in single precision: drawn, not tested); the files written
     (those of figures no longer configured are removed)."""
     shutil.rmtree(folder, ignore_errors=True)
-    specs = [spec for spec in experiment.get("report", {}).get("figures", []) if spec["kind"] in CURVES]
+    specs = [spec for spec in figure_specs(experiment) if spec.curved]
     records = store.load(runs) if specs else pd.DataFrame()
     written = []
     for spec in specs if len(records) else []:
-        table = curve_table(records, spec, experiment)
+        table = curve_table(records, spec, experiment, SceneFootage())
         if len(table):
             table = table.astype({c: "float32" for c in table if table[c].dtype == "float64"})
-            written.append(folder / f"{spec['name']}.parquet")
+            written.append(folder / f"{spec.name}.parquet")
             write_table(pa.Table.from_pandas(table, preserve_index=False), written[-1])
     return written
 

@@ -20,6 +20,7 @@ A bar counts the experiments drawn (``progress=false`` hides it).
 
 import shutil
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from hydra import compose, initialize_config_dir
@@ -27,6 +28,7 @@ from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
 from replication import atomic
+from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.settings import configure
@@ -36,9 +38,8 @@ from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
-from replication.report.pages.experiment import write_experiment_report
+from replication.report.experiments import write_experiment, write_multiverse
 from replication.report.pages.index import write_index
-from replication.report.pages.multiverse import write_multiverse_report
 from replication.report.pages.recorded import STATUS, write_status
 from replication.runner.config import expand
 from replication.runner.multiverse import load as load_multiverse
@@ -47,48 +48,50 @@ from replication.runner.results import Results
 from replication.runner.store import Store
 from replication.scales import report_folder
 
-SWITCHES = {"pdf": True, "screenshot": False}  # ours, not Hydra's: name=true|false
 SCREENSHOT = "screenshot.png"
 PICTURE = "scorecard.png"  # the record's first page beside its findings (the README shows it)
 README_PATH = "README.md"  # whose part on the record (its size, what made it, what each part took) findings renders
-OPTIONS = ("sweep", "metric", "source")  # ours too: name=text
 SOURCES = ("store", "record")
+
+
+@dataclass(frozen=True)
+class Options:
+    """The command's own settings; every other argument is a setting of the config (Hydra's)."""
+
+    experiment: tuple[str, ...] | None = None  # every experiment by default
+    pdf: bool = True
+    screenshot: bool = False
+    sweep: str | None = None  # <key>=v1,v2,...: a multirun's sweep
+    metric: str | None = None  # the sweep's column
+    source: str = "store"  # or record
 
 
 def main(argv: list[str]) -> None:
     if {"--help", "-h"} & set(argv):
         print(__doc__.strip())
         return
-    chosen = [a.split("=", 1)[1].split(",") for a in argv if a.startswith("experiment=")]
-    names = chosen[-1] if chosen else experiment_names()
-    switches = dict(SWITCHES)
-    for arg in argv:
-        name, _, value = arg.partition("=")
-        if name in SWITCHES:
-            if value.lower() not in ("true", "false"):
-                fail(f"{name} must be true or false, got {value!r}")
-            switches[name] = value.lower() == "true"
-    options = {a.partition("=")[0]: a.partition("=")[2] for a in argv if a.partition("=")[0] in OPTIONS}
-    overrides = [a for a in argv if not a.startswith("experiment=") and a.partition("=")[0] not in (*SWITCHES, *OPTIONS)]
+    options, overrides = read(argv, Options, "report", handed=("*",))
+    chosen = options.experiment is not None
+    names = options.experiment if chosen else experiment_names()
     unknown = sorted(set(names) - set(experiment_names()))
     if unknown:
         fail(f"unknown experiment {unknown[0]!r}; known: {', '.join(experiment_names())}")
-    if "sweep" in options:
+    if options.sweep is not None:
         if len(names) != 1:
             fail("sweep= needs one experiment=<name>: the one the multirun ran")
-        return report_sweep(names[0], options["sweep"], options.get("metric"), overrides)
-    if "metric" in options:
+        return report_sweep(names[0], options.sweep, options.metric, overrides)
+    if options.metric is not None:
         fail("metric= only goes with sweep=")
-    source = options.get("source", "store")
+    source = options.source
     if source not in SOURCES:
         fail(f"source must be one of {', '.join(SOURCES)}, got {source!r}")
     if source == "record":
-        names, overrides = recorded_experiments(names, overrides, bool(chosen))
+        names, overrides = recorded_experiments(names, overrides, chosen)
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # the settings: workers, folders
         cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
     try:  # each experiment's pages on its own worker (the order of the output is the experiments')
         pages = Parallel(n_jobs=cfg.n_jobs, return_as="generator")(
-            delayed(draw)(name, overrides, source, bool(chosen)) for name in names)
+            delayed(draw)(name, overrides, source, chosen) for name in names)
         drawn = list(tqdm(pages, total=len(names), desc="pages", unit="experiment", disable=not cfg.progress,
                           mininterval=1.0))
     except ConfigError as error:
@@ -105,21 +108,22 @@ def main(argv: list[str]) -> None:
         held = resolve(cfg.record)
         drawn_from = drawn_inputs(inputs(held, resolve(cfg.findings) / "templates", published_path(cfg.published_values)))
         print(f"status: {write_status(reports, Manifest.read(held), stale, designed, drawn_from, read_profile(held))}")
-    if switches["pdf"]:
+    if options.pdf:
         from replication.report.pdf import write_pdf
 
         print(f"pdf: {write_pdf(reports, cfg.published_values)}")
     index = write_index(reports, cfg.published_values)
     templates = resolve(cfg.findings) / "templates"
     if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
-        try:  # rendered from the index's claims.csv and summary.csv, then linked from it
-            for page in write_html(render_findings(Drawn(reports), templates), reports / "findings"):
+        try:  # rendered from the summaries the index read, then linked from it
+            for page in write_html(render_findings(Drawn(reports, cfg.published_values), templates),
+                                   reports / "findings"):
                 print(f"findings: {page}")
             index = write_index(reports, cfg.published_values)
         except LookupError as error:
             print(f"findings: not drawn: {error}", file=sys.stderr)
     print(f"index: {index}")
-    if switches["screenshot"]:
+    if options.screenshot:
         from replication.report.pages.render import browser, open_in_browser
 
         if browser() is None:
@@ -149,23 +153,23 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[st
         configure(cfg.inference)
         if "multiverse" in cfg.experiment and source == "record":  # every universe's recorded runs
             multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
-            page = write_multiverse_report(cfg, multiverse, tuple(overrides),
-                                           lambda name, u: record.universe(multiverse.name, u.name))
+            page = write_multiverse(cfg, multiverse, tuple(overrides),
+                                    lambda name, u: record.universe(multiverse.name, u.name))
             return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
                                    for u in multiverse.universes for e in multiverse.experiments), \
                 len(multiverse.universes)
         if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs (at paper scale,
             multiverse = load_multiverse(cfg)  # the record's beneath them, as the run read them)
-            return name, write_multiverse_report(cfg, multiverse, tuple(overrides),
-                                                 reader(*universes_beneath(cfg, multiverse))), None, 0
+            return name, write_multiverse(cfg, multiverse, tuple(overrides),
+                                          reader(*universes_beneath(cfg, multiverse))), None, 0
         if source == "record":
             store = Record(resolve(cfg.record))
             results = Results.of(cfg, expand(cfg), store, tuple(overrides), store.curves(name))
-            return name, write_experiment_report(cfg, results), len(store.stale(results.runs)), 0
+            return name, write_experiment(cfg, results), len(store.stale(results.runs)), 0
         runs = expand(cfg)
         held = beneath(cfg, runs, Store(resolve(cfg.store), name))  # at paper scale, as the run read them
         results = Results.of(cfg, runs, held, tuple(overrides), held.curves)
-        return name, write_experiment_report(cfg, results), None, 0
+        return name, write_experiment(cfg, results), None, 0
 
 
 def findings(argv: list[str]) -> None:
@@ -181,7 +185,7 @@ def findings(argv: list[str]) -> None:
     record, out = resolve(settings["record"]), resolve(settings["findings"])
     if not (record / MANIFEST).exists():
         fail(f"{record}: no record here (make record writes one from a paper-scale store)")
-    drawn = Drawn(resolve(settings["reports"]) / PAGES)
+    drawn = Drawn(resolve(settings["reports"]) / PAGES, settings["published_values"])
     rendered_from = inputs(record, out / "templates", published_path(settings["published_values"]))
     if drawn_pages(record, argv) is None:  # another record, configs or code
         (drawn.folder / SCREENSHOT).unlink(missing_ok=True)  # never an older drawing's picture
@@ -258,7 +262,7 @@ def report_sweep(name: str, sweep: str, metric: str | None, overrides: list[str]
             page = write_sweep_report(records, key, metric or default_metric(experiment), experiment,
                                       report_folder(resolve(cfg.reports), results.name, cfg.scale) / "sweeps",
                                       missing, command)
-            write_experiment_report(cfg, results)  # now linking the sweep
+            write_experiment(cfg, results)  # now linking the sweep
         except (ConfigError, HydraException, OmegaConfBaseException) as error:  # a bad key, value or metric
             fail(str(error).splitlines()[0])
     for line in missing:

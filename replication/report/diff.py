@@ -3,8 +3,11 @@ sets of results, before and after.
 
 A and B are each a record folder (``record/``, or any folder holding its ``manifest.json``: its pages are
 drawn first, as ``report source=record`` draws them, unless ``reports/record`` holds them drawn from that
-very record by this code), a drawn report folder (one holding ``claims.csv`` and ``summary.csv``:
-``reports``, ``reports/record``), or ``store``: the runs in the store at the paper scale.  Each is named as it
+very record by this code), a drawn report folder (one holding the experiments' ``summary.json`` files:
+``reports``, ``reports/record``), or ``store``: the runs in the store at the paper scale.  What is compared is
+what the summaries decide, read through their schema (:class:`~replication.evidence.scorecard.Scorecard`, against
+the package's published values): the claims and cells ``claims.csv`` and ``summary.csv`` export, never those
+files read back.  Each is named as it
 was given, with what is done with it (drawing a record's pages shows a bar of its experiments); the scratch
 folders pages are drawn into are never named, since they are gone when the command ends.  Then one line per
 changed claim (verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict),
@@ -24,8 +27,13 @@ from pathlib import Path
 import pandas as pd
 
 from replication.errors import fail
+from replication.evidence.claims import load_papers
+from replication.evidence.published import load_published, published_path
+from replication.evidence.scorecard import Scorecard
+from replication.evidence.summary import load_summaries
 from replication.paths import resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest
+from replication.scales import SCALES, report_folder
 
 CLAIM = ("claim_id",)
 CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost")
@@ -38,7 +46,7 @@ NO_RECORD = ("a record is a folder holding manifest.json, such as the repository
 
 def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs: int | None = None,
           side: str = "") -> Path:
-    """The report folder holding ``source``'s ``claims.csv`` and ``summary.csv``, drawing it into ``scratch``
+    """The report folder holding ``source``'s summaries (:func:`is_drawn`), drawing it into ``scratch``
     first if need be (of a record, only its ``experiments`` where named, on ``n_jobs`` workers where given).
     The drawing shows a bar of the experiments drawn.  With ``side`` (A or B), say first what ``source`` is and
     what is done with it; of a whole record, read ``reports/record`` where it holds that record's pages as this
@@ -53,7 +61,7 @@ def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs:
     path = resolve(source) if source != "store" else Path(source)
     # the scratch folder's pages, named nowhere; no findings (only the claims and cells are compared)
     settings = [f"reports={scratch}", "pdf=false", f"findings={scratch / 'no-findings'}"]
-    if (path / "claims.csv").exists() and (path / "summary.csv").exists():
+    if is_drawn(path):
         say("a drawn report, read as it is")
         return path
     if (path / MANIFEST).exists():
@@ -74,8 +82,20 @@ def drawn(source: str, scratch: Path, experiments: tuple[str, ...] = (), n_jobs:
         return scratch
     if not path.exists():
         fail(f"{source}: no such folder ({path}); {NO_RECORD}")
-    fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no claims.csv and summary.csv) nor 'store'; "
+    fail(f"{source}: neither a record (no {MANIFEST}), a drawn report (no <experiment>/summary.json) nor 'store'; "
          f"{NO_RECORD}")
+
+
+def is_drawn(folder: Path) -> bool:
+    """Whether ``folder`` holds drawn reports: an experiment's ``summary.json`` at either scale."""
+    return any(any(report_folder(folder, "", scale).glob("*/summary.json")) for scale in SCALES)
+
+
+def decided(folder: Path) -> dict[tuple[str, ...], pd.DataFrame]:
+    """What the summaries in a drawn report ``folder`` decide, keyed as compared: the claims (by :data:`CLAIM`)
+    and the published cells (by :data:`CELL`), as ``claims.csv`` and ``summary.csv`` export them."""
+    card = Scorecard.of(load_summaries(folder), list(load_papers()), load_published(str(published_path(None))))
+    return {CLAIM: card.claims, CELL: card.cell_table}
 
 
 def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...],
@@ -84,7 +104,7 @@ def changes(before: pd.DataFrame, after: pd.DataFrame, key: tuple[str, ...],
     (before, after), or that only one side has (its one field ``only in``: (the side, ''))."""
     joined = before.merge(after, on=list(key), how="outer", suffixes=("_a", "_b"), indicator=True)
     found = []
-    for row in joined.fillna("").astype(str).to_dict("records"):
+    for row in joined.astype(object).fillna("").astype(str).to_dict("records"):
         name = " ".join(row[k] for k in key if row[k])
         if row["_merge"] != "both":
             found.append((name, {"only in": ("A" if row["_merge"] == "left_only" else "B", "")}))
@@ -109,11 +129,12 @@ def verdicts(before: Path, after: Path, experiments: list[str], n_jobs: int = 2)
     with ExitStack() as stack:
         folders = [drawn(str(source), Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="verdicts-"))),
                          tuple(experiments), n_jobs) for source in (before, after)]
-        tables = {key: [pd.read_csv(folder / name, dtype=str) for folder in folders]
-                  for key, name in ((CLAIM, "claims.csv"), (CELL, "summary.csv"))}
+        sides = [decided(folder) for folder in folders]
+    tables = {key: [side[key] for side in sides] for key in (CLAIM, CELL)}
     moved = [line(*change) for key, fields in VERDICTS.items() for change in changes(*tables[key], key, fields)]
     estimates = [len(changes(*tables[key], key, (field,))) for key, field in ((CLAIM, "number"), (CELL, "ours"))]
-    judged = [int(tables[CLAIM][1]["scale"].notna().sum()), int(tables[CELL][1]["verdict"].notna().sum())]
+    judged = [int((tables[key][1][column].fillna("") != "").sum()) for key, column in ((CLAIM, "scale"),
+                                                                                    (CELL, "verdict"))]
     print(f"verdicts: {judged[0]} claims and {judged[1]} published cells judged from them: {len(moved)} verdicts "
           f"changed ({estimates[0]} claims' and {estimates[1]} cells' estimates moved)")
     print(*moved, sep="\n", end="\n" if moved else "")
@@ -129,8 +150,8 @@ def main(argv: list[str]) -> None:
     with ExitStack() as stack:
         folders = [drawn(source, Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="diff-"))), side=side)
                    for side, source in zip("AB", argv)]
-        claims = [pd.read_csv(folder / "claims.csv", dtype=str) for folder in folders]
-        cells = [pd.read_csv(folder / "summary.csv", dtype=str) for folder in folders]
+        sides = [decided(folder) for folder in folders]
+    claims, cells = ([side[key] for side in sides] for key in (CLAIM, CELL))
     claim_changes = changes(*claims, CLAIM, CLAIM_FIELDS)
     claim_lines = [line(*change) for change in claim_changes]
     cell_lines = [line(*change) for change in changes(*cells, CELL, CELL_FIELDS)]

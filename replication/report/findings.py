@@ -4,14 +4,15 @@
 
 A paper's page is a hand-written Jinja template, ``docs/findings/templates/<paper>.md.j2``: the prose that
 explains (what the paper leaves open, what we chose and why, why a number differs from the paper's), with
-every number it quotes taken from the record's drawn pages (``<reports>/record``: ``claims.csv``,
-``summary.csv``, each experiment's table CSVs and ``status.json``) through these names:
+every number it quotes taken from the record's drawn pages (``<reports>/record``: the claims and cells their
+``summary.json`` files decide, read through their schema as the scorecard reads them, each experiment's table
+CSVs and ``status.json``) through these names:
 
 - ``claim("bis_pf.time")``: a claim's row (``.verdict``, ``.estimate`` "value [low, high]", ``.runs``,
   ``.why``, ``.robustness``, ``.at_equal_cost``);
 - ``table("bis_pf", "table2_error").at(method="BIS-PF", condition="scene=exp2_16_targets")``: one row of a
-  table (``.ours``, ``.estimate``, any column by name: ``row["failed runs"]``), its numbers shown to 4
-  significant digits; ``.rows`` every row;
+  table (:class:`~replication.evidence.tables.Table`, the one table class: ``.ours``, ``.estimate``, any column
+  by name: ``row["failed runs"]``), its numbers shown to 4 significant digits; ``.rows`` every row;
 - ``experiment("bis_pf")``: its runs, minutes and CPU-minutes as recorded (a multiverse's ``universes``
   recorded of those ``designed``);
 - ``scorecard()``, ``cells()``, ``times()``: the paper's claims, its published cells beside ours, and its
@@ -32,9 +33,9 @@ published values, the code) so that a check costs no drawing: :func:`stale` says
 
 import hashlib
 import json
-import math
 import re
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import jinja2
@@ -42,8 +43,10 @@ import pandas as pd
 
 from replication import atomic
 from replication.evidence.claims import Paper, load_papers
-from replication.evidence.statistics import said_level
+from replication.evidence.published import load_published, published_path
+from replication.evidence.scorecard import Scorecard
 from replication.evidence.summary import load_summaries
+from replication.evidence.tables import Table, cell_value, interval, number
 from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, PROFILE, sha256
 from replication.report.pages.recorded import STATUS
@@ -55,104 +58,48 @@ README_TEMPLATE = "_readme.md.j2"  # its template, beside the pages'
 README_MARKS = ("<!-- rendered from the record", "<!-- end of the part rendered from the record -->")
 
 
-def number(value) -> str:
-    """A number as the findings show it: 4 significant digits, thousands whole; '' when not finite."""
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
-        return ""
-    if isinstance(value, str):
-        return value
-    return f"{value:,.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
-
-
-def estimate(value, low, high, level=None) -> str:
-    """'value [low, high]', with the interval's level where given ('value [low, high] (90% CI)'), or the
-    value alone where the interval is not defined."""
-    if any(v is None or not math.isfinite(v) for v in (low, high)):
-        return number(value)
-    return f"{number(value)} [{number(low)}, {number(high)}]" + (f" ({said_level(level)})" if level else "")
-
-
 def duration(minutes: float) -> str:
     """A wall time as the findings show it: whole minutes up to an hour and a half, else hours to 0.1."""
     return f"{minutes:.0f} min" if minutes < 90 else f"{minutes / 60:.1f} h"
 
 
-def _cell(value):
-    return None if isinstance(value, float) and math.isnan(value) else value
-
-
-@dataclass(frozen=True)
-class Row:
-    """One row of a drawn table: columns by name (numbers shown as :func:`number` shows them)."""
-
-    where: str
-    values: dict
-
-    def __getitem__(self, column: str) -> str:
-        if column not in self.values:
-            raise LookupError(f"{self.where} has no column {column!r}; it has {', '.join(self.values)}")
-        return number(_cell(self.values[column]))
-
-    def __getattr__(self, column: str) -> str:
-        if column.startswith("_"):
-            raise AttributeError(column)
-        return self[column]
-
-    @property
-    def estimate(self) -> str:
-        v = self.values
-        return estimate(*(_cell(v.get(k)) for k in ("ours", "ci_low", "ci_high")))
-
-
-@dataclass(frozen=True)
-class Table:
-    where: str
-    frame: pd.DataFrame
-
-    @property
-    def rows(self) -> list[Row]:
-        return [Row(f"{self.where} row {i}", row) for i, row in enumerate(self.frame.to_dict("records"))]
-
-    def at(self, **match) -> Row:
-        """The one row whose columns equal ``match``."""
-        picked = self.frame
-        for column, value in match.items():
-            if column not in picked:
-                raise LookupError(f"{self.where} has no column {column!r}")
-            picked = picked[picked[column].astype(str) == str(value)]
-        where = f"{self.where} at {', '.join(f'{k}={v}' for k, v in match.items())}"
-        if len(picked) != 1:
-            raise LookupError(f"{where}: {len(picked)} rows, not one")
-        return Row(where, picked.iloc[0].to_dict())
-
-
 @dataclass(frozen=True)
 class Drawn:
-    """The record's drawn pages (``<reports>/record``) as the templates read them."""
+    """The record's drawn pages (``<reports>/record``) as the templates read them: the claims and cells their
+    summaries decide (judged against ``published``, the default values where none is given), their tables and
+    status."""
 
     folder: Path
+    published: Path | None = None
+    decided: Scorecard | None = None  # what they decide; None: what the folder's summaries decide
 
     @property
     def status(self) -> dict:
         return json.loads((self.folder / STATUS).read_text())
 
+    @cached_property
+    def card(self) -> Scorecard:
+        return self.decided or Scorecard.of(load_summaries(self.folder), list(load_papers()),
+                                            load_published(str(published_path(self.published))))
+
     @property
     def claims(self) -> pd.DataFrame:
-        return pd.read_csv(self.folder / "claims.csv", keep_default_na=False, na_values=[""])
+        return self.card.claims
 
     @property
     def cells(self) -> pd.DataFrame:
-        return pd.read_csv(self.folder / "summary.csv", keep_default_na=False, na_values=[""], dtype={"ours": str})
+        return self.card.cell_table
 
     def table(self, experiment: str, name: str) -> Table:
+        """One of an experiment's tables as its page wrote it (numbers shown as :func:`number` shows them)."""
         path = self.folder / experiment / f"{name}.csv"
         if not path.exists():
             raise LookupError(f"the record's pages have no table {experiment}/{name}")
-        return Table(f"{experiment}/{name}", pd.read_csv(path))
+        return Table.read(pd.read_csv(path), f"{experiment}/{name}")
 
     def experiments_of(self, paper: str) -> list[str]:
         """The paper's experiments the record holds, by their summaries."""
-        return [name for name, summary in load_summaries(self.folder).items() if summary.paper == paper]
+        return [name for name, summary in self.card.summaries.items() if summary.paper == paper]
 
 
 def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
@@ -164,9 +111,9 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     def claim(claim_id: str) -> dict:
         if claim_id not in claims.index:
             raise LookupError(f"the record has no claim {claim_id!r}")
-        c = {k: _cell(v) for k, v in claims.loc[claim_id].to_dict().items()}
+        c = {k: cell_value(v) for k, v in claims.loc[claim_id].to_dict().items()}
         return {**c, "verdict": c["verdict"], "why": c["reason"], "runs": number(c["runs"]),
-                "estimate": estimate(c["number"], c["ci_low"], c["ci_high"]) if c["number"] is not None else ""}
+                "estimate": interval(c["number"], c["ci_low"], c["ci_high"]) if c["number"] is not None else ""}
 
     def experiment(name: str) -> dict:
         if name not in status["experiments"]:
@@ -178,7 +125,7 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         header = ["claim", "the paper says", "verdict", "deciding", "estimate [interval]", "runs", "under every reading"]
         return markdown_table(header,
                               [[f"`{c}`: {t}", f"\u201c{q}\u201d ({w})", f"**{v}**", d or "",
-                                estimate(n, lo, hi, _cell(lv)) if n == n else "", number(r) if r == r else "", rb or ""]
+                                interval(n, lo, hi, cell_value(lv)) if n == n else "", number(r) if r == r else "", rb or ""]
                                for c, t, q, w, v, d, n, lo, hi, lv, r, rb in rows[
                                    ["claim_id", "claim", "quote_english", "where", "verdict", "deciding", "number",
                                     "ci_low", "ci_high", "level", "runs", "robustness"]].itertuples(index=False)])

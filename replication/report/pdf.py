@@ -13,6 +13,7 @@ import datetime
 import re
 import sys
 import textwrap
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
@@ -28,6 +29,7 @@ from matplotlib.patches import Rectangle  # noqa: E402
 
 import replication  # noqa: E402
 from replication import atomic  # noqa: E402
+from replication.arguments import read  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
@@ -36,9 +38,9 @@ from replication.report.pages.index import TITLE  # noqa: E402
 from replication.evidence.published import load_published, published_path  # noqa: E402
 from replication.evidence.claims import Paper, load_papers  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
-from replication.evidence.scorecard import cell_tallies, claim_rows, owner_of_cells, tally  # noqa: E402
+from replication.evidence.scorecard import Scorecard, tally  # noqa: E402
 from replication.evidence.schema import Summary  # noqa: E402
-from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table  # noqa: E402
+from replication.evidence.summary import counts, load_summaries  # noqa: E402
 from replication.evidence.tables import Table  # noqa: E402
 from replication.evidence.settings import rules  # noqa: E402
 from replication.scales import report_folder  # noqa: E402
@@ -60,25 +62,21 @@ def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path
     """Write ``reports/replication.pdf`` from what ``reports/`` holds; return its path."""
     reports = Path(reports)
     summaries = load_summaries(reports)
-    configs = experiment_configs()
-    published = load_published(str(published_path(published_values)))
     papers = load_papers()
-    rows = claim_rows(papers, summaries)
-    cells = summary_table(published, summaries, configs, owner_of_cells(papers, published))
+    card = Scorecard.of(summaries, papers, load_published(str(published_path(published_values))))
     path = reports / "replication.pdf"
     reports.mkdir(parents=True, exist_ok=True)
     quick = [name for name, s in summaries.items() if s.scale != "paper"]
     banner = (f"Quick scale ({len(quick)} of {len(summaries)} experiments): fewer runs and shorter scenes than "
               f"the papers'. Paper scale: {PAPER_COMMAND}." if quick else None)
     with atomic.replacing(path) as tmp:  # the book and its outline whole, then in place of the last one
-        _write_book(tmp, reports, summaries, cells, rows, papers, banner)
+        _write_book(tmp, reports, card, papers, banner)
     return path
 
 
-def _write_book(path: Path, reports: Path, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict,
-                papers: list[Paper], banner: str | None) -> None:
+def _write_book(path: Path, reports: Path, card: Scorecard, papers: list[Paper], banner: str | None) -> None:
     """Every page of the book as ``path``, then its outline."""
-    tallies = cell_tallies(cells)
+    summaries, cells, rows, tallies = card.summaries, card.cells, card.rows, card.tallies
     with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path, banner) as pdf:
         _title_page(pdf, summaries, cells, rows, glance.write(reports, papers, rows))
         for paper in papers:
@@ -402,18 +400,20 @@ def _outline(path: Path, marks: list[tuple[str, str | None, int]]) -> None:
     writer.write(str(path))
 
 
+@dataclass(frozen=True)
+class Options:
+    reports: str | None = None
+    published_values: str | None = None
+
+
 def main(argv: list[str]) -> None:
-    options = dict(a.split("=", 1) for a in argv if "=" in a)
-    unknown = set(options) - {"reports", "published_values"}
-    if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.pdf [reports=DIR] [published_values=CSV]", file=sys.stderr)
-        raise SystemExit(2)
+    options, _ = read(argv, Options, "python -m replication.report.pdf")
     from replication.report.pages.index import write_index
 
-    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    path = write_pdf(reports, options.get("published_values"))
+    reports = resolve(options.reports or OmegaConf.load(CONF_DIR / "config.yaml").reports)
+    path = write_pdf(reports, options.published_values)
     print(f"pdf: {path}")
-    print(f"index: {write_index(reports, options.get('published_values'))}")
+    print(f"index: {write_index(reports, options.published_values)}")
 
 
 if __name__ == "__main__":

@@ -41,12 +41,12 @@ from replication.runner.lifeline import start_worker
 from replication.runner.memory import one_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
-from replication.stopwatch import Stopwatch, load_1m
+from replication.stopwatch import Stopwatch, load_1m, machine_speed
 from replication.tasks import TASKS
 
 # machine- and moment-dependent: left out of determinism checks
 TIMING_COLUMNS = ("wall_s", "cpu_s", "ms_per_step", "cpu_ms_per_step", "ms_per_frame", "cpu_ms_per_frame", "filter_s",
-                  "cpu_filter_s", "fps", "load_1m", "computed_at")
+                  "cpu_filter_s", "fps", "load_1m", "reference_ms", "computed_at")
 BACKENDS = ("loky", "threading", "dask", "ray")
 CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
 # ray's joblib backend returns whole lists only (no return_as="generator_unordered"): its records are
@@ -92,6 +92,7 @@ def _performed(run: Run) -> dict:
         "wall_s": stopwatch.wall,
         "cpu_s": stopwatch.cpu,  # this thread's: the run's own work, whatever else the machine did
         "load_1m": load_1m(),  # the machine's, as the run ended: above its cores, runs waited for one
+        "reference_ms": machine_speed(),  # the machine's speed about then: a fixed work's time on this worker
         "base_seed": run.base_seed,
         "replication_version": replication.__version__,
         **provenance(),

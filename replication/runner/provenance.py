@@ -30,10 +30,10 @@ from replication.runner.machine import machine
 
 PACKAGE = Path(__file__).resolve().parent.parent
 # what never computes a run (prefixes of paths inside the package): the evidence and report layers (deciding
-# and drawing), the command line and its checks, the reader of stored runs and the export of results for
-# other toolkits, and the paper-scale record
+# and drawing), the command line and its checks, the reader of stored runs, what the judge and the figures read
+# of the runs' video and series, the export of results for other toolkits, and the paper-scale record
 READ_ONLY = ("evidence/", "report/", "record/", "cli.py", "__main__.py", "scenes/__main__.py", "runner/preflight.py",
-             "runner/results.py", "export.py")
+             "runner/results.py", "runner/footage.py", "runner/curves.py", "export.py")
 # modules that gather others by name (re-exports, registries): their source counts for a run that imports them,
 # the modules they gather do not (the run's own task and filter are its entries)
 GATHERING = ("__init__.py", "filters/__init__.py", "tasks/__init__.py")

@@ -3,7 +3,8 @@
 Each raises :class:`ConfigError` with one line naming the bad key: a value of
 the wrong type for the filter it goes to, a look no figure can draw, an unknown
 ``parallel.*`` key or backend, a scene of an unknown kind or a real one whose folder
-does not exist or whose frames and ground truth do not pair up (the missing frames named), a condition a
+does not exist or whose frames and ground truth do not pair up (the missing frames named), a table, figure
+or claim's test of an unknown kind or with an option its kind does not take, a condition a
 table, a figure or a claim names that no run of the experiment has.  :func:`prepare`
 runs them all and expands the experiment into its runs.
 """
@@ -18,8 +19,9 @@ from omegaconf import DictConfig, OmegaConf
 from replication.condition import Condition
 from replication.errors import ConfigError
 from replication.evidence.curves import figure_conditions
+from replication.evidence.figures import FigureSpec, figure_specs
 from replication.evidence.named_conditions import holds, written
-from replication.evidence.tables import matched
+from replication.evidence.tables import Compared, TableSpec, matched, table_specs
 from replication.display import asked_look
 from replication.filters.registry import RESERVED, builder
 from replication.paths import experiment_names, resolve
@@ -202,6 +204,7 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
         load_own_papers(resolve(str(cfg.claims_dir)))
     check_scenes(cfg)
     check_frames(cfg)
+    check_report(cfg)
     check_conditions(cfg)
     skipped: list[str] = []
     runs = expand(cfg, skipped)
@@ -212,16 +215,44 @@ def prepare(cfg: DictConfig) -> tuple[list[Run], list[str], tuple[str, int, str 
     return runs, skipped + tables_without_runs(cfg, runs), settings
 
 
+REPORT_KEYS = ("tables", "figures", "sequence_pages")
+
+
+def report_specs(cfg: DictConfig) -> tuple[tuple[TableSpec, ...], tuple[FigureSpec, ...]]:
+    """The experiment's report tables and figures as typed specs, each checked against its kind
+    (:func:`~replication.evidence.tables.table_specs`, :func:`~replication.evidence.figures.figure_specs`):
+    an unknown kind, key or option is one line naming the file, the entry and the options known."""
+    file = f"experiment/{cfg.experiment.name}.yaml"
+    experiment = experiment_at_scale(cfg)
+    report = experiment.get("report") or {}
+    unknown = sorted(set(report) - set(REPORT_KEYS)) if isinstance(report, dict) else []
+    if unknown:
+        raise ConfigError(f"{file}: unknown key report.{unknown[0]}; report takes {', '.join(REPORT_KEYS)}")
+    return table_specs(experiment, file), figure_specs(experiment, file)
+
+
+def check_report(cfg: DictConfig) -> None:
+    """The report's specs (:func:`report_specs`), and the figures its ``sequence_pages`` name among them."""
+    if "multiverse" in cfg.experiment:
+        return  # its universes' reports are their experiments', checked as shipped
+    _, figures = report_specs(cfg)
+    pages = (experiment_at_scale(cfg).get("report") or {}).get("sequence_pages") or []
+    unknown = sorted(set(pages) - {figure.name for figure in figures})
+    if unknown:
+        raise ConfigError(f"experiment/{cfg.experiment.name}.yaml: report.sequence_pages names no figure "
+                          f"{unknown[0]!r}; figures: {', '.join(figure.name for figure in figures)}")
+
+
 def tables_without_runs(cfg: DictConfig, runs: list[Run]) -> list[str]:
     """A line for each report table whose conditions (those its ``match:`` lists) no run of this request
     has (bis_pf run without its 3123 scene): said before any work, the page then leaves the table out."""
-    tables = OmegaConf.to_container(cfg.experiment, resolve=True).get("report", {}).get("tables", [])
+    tables, _ = report_specs(cfg)
     ran = list({str(run.condition): run.condition for run in runs}.values())
     lines = []
     for spec in tables:
-        wanted = [condition for condition, _ in matched(spec)]
+        wanted = [condition for condition, _ in matched(spec)] if isinstance(spec, Compared) else []
         if wanted and not _held(ran, wanted):
-            lines.append(f"{cfg.experiment.name}: table {spec['name']} needs {' or '.join(map(written, wanted))}, "
+            lines.append(f"{cfg.experiment.name}: table {spec.name} needs {' or '.join(map(written, wanted))}, "
                          "which no run of this request has: its page will leave it out")
     return lines
 
@@ -229,16 +260,17 @@ def tables_without_runs(cfg: DictConfig, runs: list[Run]) -> list[str]:
 def named_conditions(cfg: DictConfig) -> list[tuple[str, dict]]:
     """Each condition the experiment's report tables (``match:``) and figures (``conditions:``) name, and the
     claims' readings of it (the papers', and a user's own in ``claims_dir``), with where it is written."""
-    from replication.evidence.claims import load_own_papers, load_papers, named
+    from replication.evidence.claim_tests import named
+    from replication.evidence.claims import load_own_papers, load_papers
 
     name = cfg.experiment.name
     file = f"experiment/{name}.yaml"
-    report = OmegaConf.to_container(cfg.experiment, resolve=True).get("report") or {}
+    tables, figures = report_specs(cfg)
     try:  # a label is refused here, in the file's name
-        found = [(f"{file}: table {spec.get('name')!r}: match", condition)
-                 for spec in report.get("tables", []) for condition, _ in matched(spec)]
-        found += [(f"{file}: figure {spec.get('name')!r}: conditions", condition)
-                  for spec in report.get("figures", []) for condition in figure_conditions(spec)]
+        found = [(f"{file}: table {spec.name!r}: match", condition)
+                 for spec in tables if isinstance(spec, Compared) for condition, _ in matched(spec)]
+        found += [(f"{file}: figure {spec.name!r}: conditions", condition)
+                  for spec in figures for condition in figure_conditions(spec)]
     except ConfigError as error:
         raise ConfigError(f"{file}: {error}") from None
     papers = load_papers() + (load_own_papers(resolve(str(cfg.claims_dir))) if cfg.get("claims_dir") else ())

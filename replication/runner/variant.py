@@ -23,7 +23,6 @@ from replication.paths import CONF_DIR, experiment_names
 from replication.runner.config import experiment_at_scale
 from replication.scenes.factory import SCENE_KINDS, scene_kind
 
-SHOWN = 12  # differences listed on a page; the digest covers them all
 NOT_COMPARED = ("runs", "also")  # the run count (the same experiment, repeated more or less) and the companions
 
 

@@ -3,6 +3,10 @@
 from replication.evidence.tables import (  # noqa: F401  (each registers its kind)
     attributes, comparison, discrepancy, improvement, modes, ranking, rating, summary, tuning,
 )
-from replication.evidence.tables.table import KEYS, CellResult, Table, TableKind, match, matched, pair
+from replication.evidence.tables.table import (
+    KEYS, TABLE_KINDS, CellResult, Compared, Row, Table, TableKind, TableSpec, cell_value, interval, match, matched,
+    number, pair, table_spec, table_specs,
+)
 
-__all__ = ["KEYS", "CellResult", "Table", "TableKind", "match", "matched", "pair"]
+__all__ = ["KEYS", "TABLE_KINDS", "CellResult", "Compared", "Row", "Table", "TableKind", "TableSpec", "cell_value",
+           "interval", "match", "matched", "number", "pair", "table_spec", "table_specs"]

@@ -13,7 +13,7 @@ class Attributes(TableKind):
     compares = False
 
     def build(self, records: pd.DataFrame) -> Table:
-        scores = attribute_scores(records, self.experiment)
+        scores = attribute_scores(records, self.experiment, self.footage)
         return Table(pd.DataFrame({
             "attribute": [f"{code} ({meaning})" for code, meaning in zip(scores["attribute"], scores["meaning"])],
             "sequences": [carried_by(sequences) for sequences in scores["sequences"]],

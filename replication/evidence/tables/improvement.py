@@ -1,12 +1,13 @@
 """A relative improvement in %, from paired runs (hspf's 1.8 %)."""
 
 import math
+from dataclasses import dataclass
 
 import pandas as pd
 
 from replication.evidence.quantities import quantity
 from replication.evidence.statistics import paired_difference
-from replication.evidence.tables.table import Table, TableKind, pair
+from replication.evidence.tables.table import Compared, Table, TableKind, pair
 from replication.evidence.verdict import judge_value
 from replication.evidence.settings import INFERENCE
 
@@ -16,9 +17,22 @@ class Improvement(TableKind):
 
     kind = "improvement"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(Compared):
+        """``method`` against ``baseline`` on ``metric``, judged within ``tolerance_pp`` percentage points."""
+
+        metric: str
+        baseline: str
+        method: str
+        tolerance_pp: float
+
+        @property
+        def published_metric(self) -> str:
+            return self.paper_metric or self.metric
+
     def build(self, records: pd.DataFrame) -> Table:
         spec = self.spec
-        metric, baseline, method = spec["metric"], spec["baseline"], spec["method"]
+        metric, baseline, method = spec.metric, spec.baseline, spec.method
         paired = pair(records, metric, baseline, method)
         if paired.empty:
             return Table(pd.DataFrame())
@@ -29,7 +43,7 @@ class Improvement(TableKind):
         paper = float(theirs["number"].iloc[0]) if len(theirs) else math.nan
         # equivalence within an absolute margin in percentage points (the config's ``tolerance_pp``): a
         # relative margin of a 1.8 % improvement would be a hair's breadth
-        margin = spec["tolerance_pp"]
+        margin = spec.tolerance_pp
         verdict = judge_value(paper, improvements, quantity("improvement"),
                               tolerance=margin / abs(paper) if paper else INFERENCE.tolerance)
         row = {"method": f"{self.label(method)} vs {self.label(baseline)}", "condition": "-",

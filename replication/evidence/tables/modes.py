@@ -9,15 +9,18 @@ counts as two-mode when at least ``mass`` of the marginal lies within
 hypotheses are more than 2 ``width`` apart (before that they are one mode).
 A run keeps both modes when most of those frames do; a method does when
 most of its runs do (the table kind :class:`Modes`).
-The hypotheses come from the video each run saw (its ``scene_seed``).
+The hypotheses come from the video each run saw (its ``scene_seed``), read through the caller's
+:class:`~replication.evidence.footage.Footage`.
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from replication.evidence.aggregate import sequence_seen
+from replication.evidence.footage import Footage
 from replication.evidence.statistics import proportion
-from replication.evidence.tables.table import Table, TableKind, match
+from replication.evidence.tables.table import Compared, Table, TableKind, match
 from replication.evidence.verdict import judge_band
 
 
@@ -33,16 +36,16 @@ def two_mode_share(density: np.ndarray, hypotheses: np.ndarray, extent: float, w
     return float(held.all(axis=1)[apart].mean())
 
 
-def runs_keeping_both_modes(group: pd.DataFrame, spec: dict, experiment: dict) -> np.ndarray:
+def runs_keeping_both_modes(group: pd.DataFrame, spec: "Modes.Spec", experiment: dict, footage: Footage) -> np.ndarray:
     """Per run of one (method, condition): the share of the window's frames whose marginal of the hidden
     target holds ``spec.mass`` within ``spec.width`` px of each hypothesis (``spec.hypotheses``' targets)."""
-    first, last = spec["window"]
-    width, mass = spec.get("width", 5.0), spec.get("mass", 0.1)
+    first, last = spec.window
+    width, mass = spec.width, spec.mass
     shares = []
     for index, run in group.iterrows():
-        sequence = sequence_seen(experiment, group.loc[[index]])
+        sequence = footage.seen(experiment, group.loc[[index]])
         axis = "xy".index(run["strip"]["axis"])
-        truth = sequence.truth[first : last + 1, spec["hypotheses"]]  # frames first..last; strips start at frame 1
+        truth = sequence.truth[first : last + 1, list(spec.hypotheses)]  # frames first..last; strips start at frame 1
         hypotheses = truth[..., axis] + truth[..., axis + 2] / 2
         density = np.asarray(run["strip"]["density"])[first - 1 : last]
         shares.append(two_mode_share(density, hypotheses, sequence.size[axis], width, mass))
@@ -56,12 +59,22 @@ class Modes(TableKind):
     reads = ("strip",)
     BANDS = {"success": (0.5, 1.0), "failure": (0.0, 0.5)}  # most runs keep both modes, or most do not
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(Compared):
+        """The hidden target's frames ``window`` (first, last), the targets of its two ``hypotheses``, and
+        the ``mass`` within ``width`` px of each that keeps a mode."""
+
+        window: tuple[int, int]
+        hypotheses: tuple[int, ...]
+        width: float = 5.0
+        mass: float = 0.1
+
     def build(self, records: pd.DataFrame) -> Table:
         theirs = self.theirs()
         stripped = records[records["strip"].notna()] if "strip" in records else records.iloc[:0]
         rows, entries = [], []
         for (method, condition), group in stripped.groupby(["method", "condition"], sort=False):
-            shares = runs_keeping_both_modes(group, self.spec, self.experiment)
+            shares = runs_keeping_both_modes(group, self.spec, self.experiment, self.footage)
             keeping = int((shares > 0.5).sum())
             estimate = proportion(keeping, len(shares))
             hit = match(theirs, method, group.iloc[0], self.spec)

@@ -1,11 +1,22 @@
 """Methods ranked over sequences (:mod:`replication.evidence.ranking`), and every pair of them."""
 
 import itertools
+from dataclasses import dataclass
 
 import pandas as pd
 
 from replication.evidence.ranking import Ranking, rankings, unreliable
-from replication.evidence.tables.table import Table, TableKind
+from replication.evidence.tables.table import Table, TableKind, TableSpec
+
+@dataclass(frozen=True, kw_only=True)
+class Ranked(TableSpec):
+    """Methods ranked by mean ``metric`` over the values of ``over`` (the sequences), one ranking per value of
+    ``by`` if given (:func:`~replication.evidence.ranking.rankings`)."""
+
+    metric: str
+    over: str = "scene"
+    by: str | None = None
+
 
 def _note(found: dict[str, Ranking], experiment: dict) -> str:
     """The lines under a ranking: why it is not reliable (if so), and how its rank sets fare on a sequence
@@ -37,11 +48,12 @@ class RankingTable(TableKind):
 
     kind = "ranking"
     compares = False
+    Spec = Ranked
 
     def build(self, records: pd.DataFrame) -> Table:
-        found = rankings(records, self.spec)
+        found = rankings(records, self.spec.metric, self.spec.over, self.spec.by)
         rows = [{"condition": group or "-", "method": self.label(method), "sequences": len(ranked.sequences),
-                 "runs": ranked.runs, self.spec["metric"]: ranked.score(i),
+                 "runs": ranked.runs, self.spec.metric: ranked.score(i),
                  "P(best)": round(float(ranked.p_best[i]), 3), "rank": ranked.rank(i)}
                 for group, ranked in found.items() for i, method in enumerate(ranked.methods)]
         return Table(pd.DataFrame(rows), note=_note(found, self.experiment))
@@ -54,9 +66,10 @@ class Pairwise(TableKind):
 
     kind = "pairwise"
     compares = False
+    Spec = Ranked
 
     def build(self, records: pd.DataFrame) -> Table:
-        found, metric = rankings(records, self.spec), self.spec["metric"]
+        found, metric = rankings(records, self.spec.metric, self.spec.over, self.spec.by), self.spec.metric
         rows = [{"condition": group or "-", "A": self.label(ranked.methods[a]),
                  "B": self.label(ranked.methods[b]), "sequences": len(ranked.sequences), "runs": ranked.runs,
                  "P(A beats B)": round(float(ranked.beats[a, b]), 3),

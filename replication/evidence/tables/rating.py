@@ -1,9 +1,11 @@
 """Failed runs rated, beside the paper's rating (bis_pf Table 3)."""
 
+from dataclasses import dataclass
+
 import pandas as pd
 
 from replication.evidence.statistics import proportion
-from replication.evidence.tables.table import Table, TableKind, match
+from replication.evidence.tables.table import Compared, Table, TableKind, match
 from replication.evidence.verdict import judge_band, stability_bands
 
 class Rating(TableKind):
@@ -11,11 +13,19 @@ class Rating(TableKind):
 
     kind = "rating"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(Compared):
+        metric: str  # a yes/no outcome per run (failed)
+
+        @property
+        def published_metric(self) -> str:
+            return self.paper_metric or self.metric
+
     def build(self, records: pd.DataFrame) -> Table:
         theirs, bands = self.theirs(), stability_bands()
         rows, entries = [], []
         for (method, condition), group in records.groupby(["method", "condition"], sort=False):
-            failures, runs = int(group[self.spec["metric"]].sum()), len(group)
+            failures, runs = int(group[self.spec.metric].sum()), len(group)
             estimate = proportion(failures, runs)
             hit = match(theirs, method, group.iloc[0], self.spec)
             paper = hit["value"].iloc[0] if len(hit) else ""

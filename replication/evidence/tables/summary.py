@@ -1,10 +1,13 @@
 """Ours only: each metric's mean and 95% interval per method and condition."""
 
+from dataclasses import dataclass
+
 import pandas as pd
 
 from replication.evidence.aggregate import summarise
 from replication.evidence.statistics import Estimate
-from replication.evidence.tables.table import Table, TableKind
+from replication.evidence.tables.table import Table, TableKind, TableSpec
+
 
 class Summary(TableKind):
     """Ours only: one row per method and condition, one column per metric: its mean and 95% interval
@@ -13,9 +16,13 @@ class Summary(TableKind):
     kind = "summary"
     compares = False
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(TableSpec):
+        metrics: tuple[str, ...]
+
     def build(self, records: pd.DataFrame) -> Table:
-        columns = {metric: summarise(records, metric) for metric in self.spec["metrics"]}
-        first = columns[self.spec["metrics"][0]]
+        columns = {metric: summarise(records, metric) for metric in self.spec.metrics}
+        first = columns[self.spec.metrics[0]]
         table = pd.DataFrame({"method": [self.label(m) for m in first["method"]],
                               "condition": [c or "-" for c in first["condition"]], "runs": first["runs"]})
         for metric, summary in columns.items():

@@ -6,22 +6,28 @@ published cells each row was matched with (by :func:`match`, the one rule
 for that) and a :class:`~replication.evidence.verdict.Verdict`.
 
 Add a kind by subclassing :class:`TableKind` in a module of this package with a
-new ``kind`` name and a ``build`` method; a spec in ``report.tables`` then names it.
+new ``kind`` name, its options (a ``Spec`` dataclass deriving from :class:`TableSpec`, or from
+:class:`Compared` where it matches published cells) and a ``build`` method; a spec in ``report.tables`` then
+names it, and the config check holds the spec to the options before any run (:func:`table_specs`).
 """
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
 
 from replication.display import method_label
 from replication.errors import ConfigError
+from replication.evidence.footage import Footage
 from replication.evidence.named_conditions import as_mapping, holds, instead_of, written
 from replication.evidence.published import cells
-from replication.evidence.statistics import Estimate
+from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import Outcome, Verdict
+from replication.kinds import Registry
+from replication.specs import Spec
 
 # the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
 # these, so the index shows how far the cells' verdicts move with it
@@ -61,15 +67,62 @@ class CellResult:
         return self.rating or ("" if self.estimate is None else str(self.estimate))
 
 
+def number(value) -> str:
+    """A number as a reader is told it: 4 significant digits, thousands whole; '' when not finite."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    if isinstance(value, str):
+        return value
+    return f"{value:,.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
+
+
+def interval(value, low, high, level=None) -> str:
+    """'value [low, high]', with the interval's level where given ('value [low, high] (90% CI)'), or the
+    value alone where the interval is not defined."""
+    if any(v is None or not math.isfinite(v) for v in (low, high)):
+        return number(value)
+    return f"{number(value)} [{number(low)}, {number(high)}]" + (f" ({said_level(level)})" if level else "")
+
+
+def cell_value(value):
+    """A table cell's value as a reader takes it: None where it is missing (NaN)."""
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+@dataclass(frozen=True)
+class Row:
+    """One row of a table as its CSV writes it: columns by name, numbers shown as :func:`number` shows them."""
+
+    where: str
+    values: dict
+
+    def __getitem__(self, column: str) -> str:
+        if column not in self.values:
+            raise LookupError(f"{self.where} has no column {column!r}; it has {', '.join(self.values)}")
+        return number(cell_value(self.values[column]))
+
+    def __getattr__(self, column: str) -> str:
+        if column.startswith("_"):
+            raise AttributeError(column)
+        return self[column]
+
+    @property
+    def estimate(self) -> str:
+        v = self.values
+        return interval(*(cell_value(v.get(k)) for k in ("ours", "ci_low", "ci_high")))
+
+
 @dataclass
 class Table:
     """Rows of ours (``frame``: numbers, and a Verdict per row where compared), the published cells
-    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), and a
-    line a reader must see beside it (``note``: a ranking that is not reliable)."""
+    they were compared with (``cells``: one JSON-ready entry each, for the summary of every cell), a
+    line a reader must see beside it (``note``: a ranking that is not reliable), and where it was read from
+    (``where``: ``bis_pf/table2_error``, named in a reader's errors)."""
 
     frame: pd.DataFrame
     cells: list[CellResult] = field(default_factory=list)
     note: str = ""
+    where: str = ""
 
     @property
     def empty(self) -> bool:
@@ -88,9 +141,27 @@ class Table:
             shown["verdict"] = ["" if v is None else str(v) for v in self.frame["verdict"]]
         return shown
 
+    @property
+    def rows(self) -> list[Row]:
+        """Its rows as :meth:`written` writes them."""
+        return [Row(f"{self.where} row {i}", row) for i, row in enumerate(self.written().to_dict("records"))]
+
+    def at(self, **match) -> Row:
+        """The one row (as :meth:`written` writes it) whose columns equal ``match``."""
+        picked = self.written()
+        for column, value in match.items():
+            if column not in picked:
+                raise LookupError(f"{self.where} has no column {column!r}")
+            picked = picked[picked[column].astype(str) == str(value)]
+        where = f"{self.where} at {', '.join(f'{k}={v}' for k, v in match.items())}"
+        if len(picked) != 1:
+            raise LookupError(f"{where}: {len(picked)} rows, not one")
+        return Row(where, picked.iloc[0].to_dict())
+
     @classmethod
-    def read(cls, frame: pd.DataFrame) -> "Table":
-        """A table back from the CSV :meth:`written` made (the PDF is drawn from those files)."""
+    def read(cls, frame: pd.DataFrame, where: str = "") -> "Table":
+        """A table back from the CSV :meth:`written` made, to print or quote (the PDF, the findings), never to
+        decide: the verdicts are the summary's."""
         frame = frame.copy()
         if {"ours", "ci_low", "ci_high", "runs", "interval"} <= set(frame.columns):
             frame["estimate"] = [Estimate(*row[:4], "" if pd.isna(row[4]) else row[4]) for row in
@@ -101,7 +172,7 @@ class Table:
         for column in [c for c in frame.columns if {f"{c}_low", f"{c}_high"} <= set(frame.columns)]:
             frame[column] = [Estimate(v, lo, hi, n, "") for v, lo, hi, n in
                              zip(frame[column], frame.pop(f"{column}_low"), frame.pop(f"{column}_high"), frame["runs"])]
-        return cls(frame)
+        return cls(frame, where=where)
 
     def written(self) -> pd.DataFrame:
         """The frame for a CSV: numbers as numbers (a metric's interval in its ``_low`` and ``_high``
@@ -125,7 +196,7 @@ def _estimate_columns(frame: pd.DataFrame) -> list[str]:
     return [c for c in frame.columns if len(frame) and all(isinstance(v, Estimate) for v in frame[c])]
 
 
-def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: dict) -> pd.DataFrame:
+def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: "Compared") -> pd.DataFrame:
     """The published cells our row (``method``, at the condition of ``ours``: a row with its label
     ``condition`` and its ``condition.<variable>`` columns) is compared with.
 
@@ -138,19 +209,19 @@ def match(theirs: pd.DataFrame, method: str, ours: Mapping, spec: dict) -> pd.Da
                   {"condition": ours["condition"]})
     chosen = theirs["method"] == method
     if "condition" in wanted:
-        chosen &= theirs["condition"].replace("", spec.get("paper_condition", "")) == wanted["condition"]
+        chosen &= theirs["condition"].replace("", spec.paper_condition) == wanted["condition"]
     if "experiment" in wanted:
         chosen &= theirs["experiment"] == wanted["experiment"]
     return theirs[chosen]
 
 
-def matched(spec: dict) -> list[tuple[dict, dict]]:
+def matched(spec: "Compared") -> list[tuple[dict, dict]]:
     """A table's ``match:``, each entry ``{ours: {scene: Girl}, paper: {experiment: single_object, condition:
     "N=10;runs=100"}}``: a condition of ours (a mapping of values,
     :mod:`~replication.evidence.named_conditions`) and the paper's cells it is compared with, by their
     experiment and their condition as ``published_values.csv`` writes it (the paper's, not ours)."""
-    entries = spec.get("match") or []
-    where = f"table {spec.get('name')!r}: match"
+    entries = spec.match or []
+    where = f"table {spec.name!r}: match"
     if isinstance(entries, Mapping):  # keyed by our condition's label
         label, paper = next(iter(entries.items()))
         paper = written(paper if isinstance(paper, Mapping) else {"condition": paper})
@@ -162,28 +233,85 @@ def matched(spec: dict) -> list[tuple[dict, dict]]:
     return [(as_mapping(entry.get("ours"), where), dict(entry["paper"])) for entry in entries]
 
 
+@dataclass(frozen=True, kw_only=True)
+class TableSpec(Spec):
+    """What every table spec names: the table (its CSV's and HTML's file name), its title, its kind."""
+
+    name: str
+    title: str = ""
+    kind: str = ""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Compared(TableSpec):
+    """A table matched with the paper's cells: those of ``paper_table`` (one or a list; none: a user's own
+    table) and ``paper_metric`` (default: the table's metric), matched by ``match`` (:func:`matched`), a cell
+    stated without its condition taking ``paper_condition``."""
+
+    paper_table: str | list[str] | None = None
+    paper_metric: str | None = None
+    match: Any = None
+    paper_condition: str = ""
+
+    @property
+    def published_metric(self) -> str | None:
+        """The metric of the paper's cells this table compares with."""
+        return self.paper_metric
+
+    @property
+    def paper_tables(self) -> list[str]:
+        table = self.paper_table
+        return [] if table is None else [str(t) for t in table] if isinstance(table, list) else [str(table)]
+
+
+TABLE_KINDS: Registry[type["TableKind"]] = Registry("table kind")
+
+
+def table_spec(written: Mapping | TableSpec, where: str = "") -> TableSpec:
+    """A table spec as its kind declares it (``kind:``; a list of ``metrics:`` is a summary, else a comparison),
+    checked (:meth:`~replication.specs.Spec.of`); ``where``: the file it is written in."""
+    if isinstance(written, TableSpec):
+        return written
+    name = written.get("name") if isinstance(written, Mapping) else None
+    where = f"{where}: table {name!r}" if where else f"table {name!r}"
+    if not isinstance(written, Mapping):
+        raise ConfigError(f"{where}: a table is a mapping of options, got {written!r}")
+    kind = written.get("kind") or ("summary" if "metrics" in written else "comparison")
+    try:
+        made = TABLE_KINDS[kind]
+    except ConfigError as error:
+        raise ConfigError(f"{where}: {error}") from None
+    return made.Spec.of({**written, "kind": kind}, f"{where} ({kind})")
+
+
+def table_specs(experiment: Mapping, where: str = "") -> tuple[TableSpec, ...]:
+    """The experiment's report tables as typed specs (``where``: its file, said in an error)."""
+    return tuple(table_spec(written, where) for written in (experiment.get("report") or {}).get("tables") or ())
+
+
 class TableKind:
-    """One kind of report table; subclasses register themselves by ``kind``."""
+    """One kind of report table; subclasses register themselves by ``kind`` and declare their options
+    (``Spec``)."""
 
     kind: ClassVar[str]
+    Spec: ClassVar[type[TableSpec]] = TableSpec
     compares: ClassVar[bool] = True  # whether its rows are matched with published cells
     reads: ClassVar[tuple[str, ...]] = ()  # the per-frame series of a run it is built from (the record keeps them)
-    registry: ClassVar[dict[str, type["TableKind"]]] = {}
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        TableKind.registry[cls.kind] = cls
+        TABLE_KINDS.register(cls.kind, cls)
 
-    def __init__(self, spec: dict, experiment: dict, published: pd.DataFrame):
-        self.spec, self.experiment, self.published = spec, experiment, published
+    def __init__(self, spec: TableSpec, experiment: dict, published: pd.DataFrame, footage: Footage | None = None):
+        self.spec, self.experiment, self.published, self.footage = spec, experiment, published, footage
 
     @classmethod
-    def of(cls, spec: dict, experiment: dict, published: pd.DataFrame) -> "TableKind":
-        """The table kind a spec names (``kind:``; a list of ``metrics:`` is a summary, else a comparison)."""
-        name = spec.get("kind") or ("summary" if "metrics" in spec else "comparison")
-        if name not in cls.registry:
-            raise ValueError(f"table {spec.get('name')!r}: unknown kind {name!r}; known: {sorted(cls.registry)}")
-        return cls.registry[name](spec, experiment, published)
+    def of(cls, spec: Mapping | TableSpec, experiment: dict, published: pd.DataFrame,
+           footage: Footage | None = None) -> "TableKind":
+        """The table kind a spec names, built on its typed spec (a mapping is checked first: :func:`table_spec`);
+        ``footage``: the video the runs saw, for a kind that reads it (the caller's)."""
+        spec = table_spec(spec)
+        return TABLE_KINDS[spec.kind](spec, experiment, published, footage)
 
     def build(self, records: pd.DataFrame) -> Table:
         raise NotImplementedError
@@ -192,15 +320,14 @@ class TableKind:
         return method_label(self.experiment, method)
 
     def theirs(self) -> pd.DataFrame:
-        spec = self.spec
-        return cells(self.published, self.experiment["paper"], spec.get("paper_table"),  # none: a user's own table
-                     spec.get("paper_metric", spec.get("metric")))
+        return cells(self.published, self.experiment["paper"], self.spec.paper_table,  # none: a user's own table
+                     self.spec.published_metric)
 
     def entry(self, index, row: dict, verdict: Verdict | None, estimate: Estimate | None, rating: str = ""
               ) -> CellResult:
         """A matched published cell for ``summary.json``: the cell's keys and our row's numbers."""
         cell = self.published.loc[index]
-        return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec["name"],
+        return CellResult(int(index), *(str(cell[k]) for k in KEYS), table_name=self.spec.name,
                           our_method=row["method"], our_condition="" if row["condition"] == "-" else row["condition"],
                           runs=int(row["runs"]),
                           paper_number=None if pd.isna(cell["number"]) else float(cell["number"]),

@@ -8,6 +8,9 @@ which it is.  Run it on data the report does not judge: the pick is then frozen 
 is judged, and this table shows how much the objective moves with the setting.
 """
 
+from dataclasses import dataclass, replace
+from typing import Any
+
 import pandas as pd
 
 from replication.evidence.quantities import quantity
@@ -18,11 +21,21 @@ from replication.evidence.tables.table import Table
 class Tuning(Summary):
     kind = "tuning"
 
+    @dataclass(frozen=True, kw_only=True)
+    class Spec(Summary.Spec):
+        """The ``objective`` the rule picks by, its ``constraint`` (``{metric: m, below: b}``) and the
+        ``method`` tuned (said in the spec; the rows are every method's)."""
+
+        objective: str
+        metrics: tuple[str, ...] = ()
+        constraint: dict[str, Any] | None = None
+        method: str = ""
+
     def build(self, records: pd.DataFrame) -> Table:
-        objective, constraint = self.spec["objective"], self.spec.get("constraint")
-        metrics = list(dict.fromkeys([objective, *([constraint["metric"]] if constraint else []),
-                                      *self.spec.get("metrics", [])]))
-        table = Summary({**self.spec, "metrics": metrics}, self.experiment, self.published).build(records).frame
+        objective, constraint = self.spec.objective, self.spec.constraint
+        metrics = tuple(dict.fromkeys([objective, *([constraint["metric"]] if constraint else []),
+                                       *self.spec.metrics]))
+        table = Summary(replace(self.spec, metrics=metrics), self.experiment, self.published).build(records).frame
         means = pd.Series([e.value for e in table[objective]], index=table.index)
         table = table.loc[means.sort_values(ascending=quantity(objective).lower_is_better, kind="stable").index]
         table = table.reset_index(drop=True)

@@ -1,58 +1,61 @@
-"""A figure kind: a function of (records, spec, experiment, path) registered under the name a spec's ``kind:``
-gives it, with the per-frame series of a run it reads, and :func:`draw`, the one way a page draws a figure."""
+"""A figure kind's drawing: a function of (records, spec, experiment, path) registered for the kind it draws
+(``@draws(PerFrameCurve)``: a kind of :mod:`replication.evidence.figures`, with its options, the series it
+reads and whether it is drawn on the video the runs saw), and :func:`draw`, the one way a page draws a figure."""
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import pandas as pd
 
-from replication.evidence.curves import CURVES, curve_table, figure_runs
+from replication.evidence.curves import figure_runs
+from replication.evidence.figures import FigureSpec, figure_spec
+from replication.evidence.footage import Footage
 from replication.evidence.named_conditions import written
 from replication.evidence.published import COLUMNS
 from replication.report.figures.style import NothingToDraw
 
-KINDS: dict[str, Callable[..., Path]] = {}
-READS: dict[str, tuple[str, ...]] = {}  # kind -> the record columns of per-frame series it draws from
+DRAWINGS: dict[type[FigureSpec], Callable[..., Path]] = {}  # a figure kind -> the function drawing it
 
 
-def figure(kind: str, reads: tuple[str, ...] = ()) -> Callable:
-    """Register the decorated function as the figure kind ``kind``, drawn from the series ``reads``
-    (``per_frame``, ``tracks``, ``strip``) of each run besides its metrics."""
+def draws(kind: type[FigureSpec]) -> Callable:
+    """Register the decorated function as the drawing of the figure kind ``kind``."""
     def register(draw_kind: Callable[..., Path]) -> Callable[..., Path]:
-        KINDS[kind], READS[kind] = draw_kind, reads
+        DRAWINGS[kind] = draw_kind
         return draw_kind
     return register
 
 
-def draw(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
-         published: pd.DataFrame | None = None, curve: pd.DataFrame | None = None) -> Path:
-    """Draw the figure ``spec`` (its ``kind`` names the function) from run records into ``path``.
+def draw(records: pd.DataFrame, spec: Mapping | FigureSpec, experiment: dict, path: Path,
+         published: pd.DataFrame | None = None, curve: pd.DataFrame | None = None, *, footage: Footage) -> Path:
+    """Draw the figure ``spec`` (its kind names the drawing; a mapping is checked first) from run records into
+    ``path``.
 
-    A spec that names a ``paper_table`` gets the published values ``published``: the file the report was
-    asked to judge against, passed down once (none: no paper values on the figure).
+    A spec that draws the paper's values (``paper_table``) gets the published values ``published``: the file
+    the report was asked to judge against, passed down once (none: no paper values on the figure).
     A spec with ``conditions: [..]`` draws the runs of those conditions only.
-    A kind that draws a curve table (:data:`~replication.evidence.curves.CURVES`) draws ``curve`` where it
-    is given (the paper-scale record keeps the table, not the runs' series), else the table of ``records``.
+    A kind that draws a curve table (``curved``) draws ``curve`` where it is given (the paper-scale record
+    keeps the table, not the runs' series), else the table ``footage`` computes from ``records``
+    (:meth:`~replication.evidence.footage.Footage.curve`, below the report); a kind drawn on the video the runs
+    saw (``filmed``) is given ``footage``.
     """
-    kind = spec["kind"]
-    if kind not in KINDS:
-        raise ValueError(f"unknown figure kind {kind!r}; choose one of {sorted(KINDS)}")
+    spec = figure_spec(spec)
     if curve is None:
-        absent = [series for series in READS.get(kind, ()) if series not in records]
+        absent = [series for series in spec.reads if series not in records]
         if absent:  # runs read from the paper-scale record, which keeps no per-frame series a table does not need
-            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: drawn from each run's {', '.join(absent)}, "
+            raise NothingToDraw(f"figure {spec.name!r}: drawn from each run's {', '.join(absent)}, "
                                 "which these records do not hold")
-        if "conditions" in spec and not figure_runs(records, spec).any():
+        if spec.conditions is not None and not figure_runs(records, spec).any():
             # a scene the figure needs was not run (dropped by an override, say)
-            shown = ", ".join(written(c) for c in spec["conditions"])
-            raise NothingToDraw(f"figure {spec.get('name', kind)!r}: no runs at conditions {shown}")
-        if kind in CURVES:
-            curve = curve_table(records, spec, experiment)
-        elif "conditions" in spec:
+            shown = ", ".join(written(c) for c in spec.conditions)
+            raise NothingToDraw(f"figure {spec.name!r}: no runs at conditions {shown}")
+        if spec.curved:
+            curve = footage.curve(records, spec, experiment)
+        elif spec.conditions is not None:
             records = records[figure_runs(records, spec)]
-    drawn = curve if kind in CURVES else records
-    if "paper_table" not in spec:
-        return KINDS[kind](drawn, spec, experiment, path)
+    drawn = curve if spec.curved else records
+    given = {"footage": footage} if spec.filmed else {}
+    if not spec.paper:
+        return DRAWINGS[type(spec)](drawn, spec, experiment, path, **given)
     if published is None:
         published = pd.DataFrame(columns=COLUMNS + ["number"])
-    return KINDS[kind](drawn, spec, experiment, path, published=published)
+    return DRAWINGS[type(spec)](drawn, spec, experiment, path, published=published, **given)

@@ -16,28 +16,27 @@ from replication.condition import label_of  # noqa: E402
 from replication.evidence.aggregate import summarise  # noqa: E402
 from replication.evidence.quantities import quantity  # noqa: E402
 from replication.evidence.statistics import mean  # noqa: E402
-from replication.report.figures.base import figure  # noqa: E402
+from replication.evidence.figures import MetricVsCost  # noqa: E402
+from replication.report.figures.base import draws  # noqa: E402
 from replication.display import method_label  # noqa: E402
 from replication.report.figures.style import axis_label, method_look, save, shades  # noqa: E402
 
-COSTS = ("evaluations_per_step", "ms_per_step")  # by default: the work counted, and the time it took
 
-
-@figure("metric_vs_cost")
-def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(MetricVsCost)
+def metric_vs_cost(records: pd.DataFrame, spec: MetricVsCost, experiment: dict, path: Path) -> Path:
     """``spec.metric`` (mean and 95% interval over runs) against each cost of ``spec.costs`` (mean over
     runs; a time's median, which a slow first run does not move; log scale), one panel per cost; a
     method's conditions (its particle counts, say) are joined by a line in order of cost with its
     interval as a band (a single condition: a point with its interval), its other swept variable
     ``spec.by`` (a scene) split into lines of their own; ``spec.log_y`` puts the metric on a log scale;
     ``spec.paired_to`` (a method) draws the metric minus that method's on the same data, run by run."""
-    metric, costs = spec["metric"], spec.get("costs", list(COSTS))
+    metric, costs = spec.metric, spec.costs
     missing = [c for c in (metric, *costs) if c not in records]
     if missing:
-        raise ValueError(f"figure {spec.get('name', 'metric_vs_cost')!r}: the runs have no {missing}")
-    reference = spec.get("paired_to")
+        raise ValueError(f"figure {spec.name!r}: the runs have no {missing}")
+    reference = spec.paired_to
     y = summarise(records, metric) if reference is None else _paired(records, metric, reference)
-    y["line"] = label_of(y, without=[v for v in _swept(y) if v != spec.get("by")], sep=" ") if spec.get("by") else ""
+    y["line"] = label_of(y, without=[v for v in _swept(y) if v != spec.by], sep=" ") if spec.by else ""
     fig, axes = plt.subplots(1, len(costs), figsize=(6 * len(costs), 4.4), squeeze=False)
     for ax, cost in zip(axes[0], costs):
         statistic = "median" if quantity(cost).machine_dependent else "mean"  # a time: robust to a slow first run
@@ -62,14 +61,14 @@ def metric_vs_cost(records: pd.DataFrame, spec: dict, experiment: dict, path: Pa
         ax.set_xscale("log")
         ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
         ax.xaxis.set_minor_formatter(FuncFormatter(_two_and_five))
-        if spec.get("log_y"):  # a method far off the others (a chain that loses the balls) on one axis
+        if spec.log_y:  # a method far off the others (a chain that loses the balls) on one axis
             ax.set_yscale("log")
             ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
         ax.set_xlabel(f"{axis_label(cost)} ({statistic} over runs, log scale)")
         ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)" if reference is None else
                       f"{axis_label(metric)} minus {reference}'s\n(same runs; mean and 95% CI)")
         ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle(textwrap.fill(spec.get("title", ""), 120), fontsize=9)
+    fig.suptitle(textwrap.fill(spec.title, 120), fontsize=9)
     axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     return save(fig, path, dpi=120)
 

@@ -21,13 +21,14 @@ from replication.evidence.curves import clip_diverged, clip_level  # noqa: E402
 from replication.report.figures.style import (  # noqa: E402
     BLACK, PAPER, axis_label, clipped_note, method_look, save, shades,
 )
-from replication.report.figures.base import figure  # noqa: E402
+from replication.evidence.figures import MetricVsCondition  # noqa: E402
+from replication.report.figures.base import draws  # noqa: E402
 
 PLAIN = FuncFormatter(lambda value, _: f"{value:g}")  # 0.1, 20, 500 rather than powers of ten
 
 
-@figure("metric_vs_condition")
-def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, path: Path,
+@draws(MetricVsCondition)
+def metric_vs_condition(records: pd.DataFrame, spec: MetricVsCondition, experiment: dict, path: Path,
                         published: pd.DataFrame | None = None) -> Path:
     """Mean and 95% interval of ``spec.metric`` against the swept variable ``spec.x``, one line per series.
 
@@ -42,15 +43,15 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
     ``published``), the paper's values are hollow diamonds in the method's
     colour (see :func:`paper_points`).
     """
-    metric = spec["metric"]
+    metric = spec.metric
     summary = _summary(records, metric, spec)
     summary = summary[summary["mean"].notna()]  # a metric the method does not have (the grid's ESS)
-    summary["x"] = pd.to_numeric(values_of(summary, spec["x"]), errors="coerce").astype(float)
-    summary["panel"] = ["" if v is None else str(v) for v in values_of(summary, spec.get("by"))]
-    summary["rest"] = label_of(summary, without=(spec["x"], spec.get("by")), sep=" ")
+    summary["x"] = pd.to_numeric(values_of(summary, spec.x), errors="coerce").astype(float)
+    summary["panel"] = ["" if v is None else str(v) for v in values_of(summary, spec.by)]
+    summary["rest"] = label_of(summary, without=(spec.x, spec.by), sep=" ")
     colours = _series_colours(summary, experiment)
     paper = (paper_points(published, spec, experiment, set(summary["method"]))
-             if published is not None and "paper_table" in spec else None)
+             if published is not None and spec.paper else None)
     reference = summary["x"].isna() & (summary["panel"] == "")  # e.g. the Bayes floor: drawn in every panel
     panels = list(dict.fromkeys(summary.loc[~reference, "panel"])) or [""]
     fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4), squeeze=False)
@@ -70,24 +71,24 @@ def metric_vs_condition(records: pd.DataFrame, spec: dict, experiment: dict, pat
                         markeredgecolor=method_look(experiment, method).colour)
         _axes(ax, spec, list(rows["x"].dropna()) + (list(paper["x"]) if paper is not None else []))
         ax.set_ylabel(f"{axis_label(metric)}\n(mean and 95% CI)")
-        title = f"{axis_label(spec['by'])}: {panel}" if panel else spec.get("title", "")
+        title = f"{axis_label(spec.by)}: {panel}" if panel else spec.title
         ax.set_title(textwrap.fill(title, 75), fontsize=9)
         legend_rows = max(legend_rows, _legend(ax))
     fig.set_figheight(4 + 0.17 * legend_rows)
     return save(fig, path, dpi=120)
 
 
-def _series(ax, rows: pd.DataFrame, colours: dict, spec: dict, experiment: dict) -> None:
+def _series(ax, rows: pd.DataFrame, colours: dict, spec: MetricVsCondition, experiment: dict) -> None:
     """One line per (method, other parameters), its 95% intervals as error bars; the lines are nudged
     apart along x so that equal means do not hide each other."""
     series = list(rows.groupby(["method", "rest"], sort=False))
     for i, ((method, rest), group) in enumerate(series):
         group = group.sort_values("x")
         label = f"{method_label(experiment, method)} {rest}".strip()
-        if spec.get("fit_slope") and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
+        if spec.fit_slope and len(group) > 1:  # power law y ~ x^slope, fitted on the log-log means
             label += f" (slope {np.polyfit(np.log(group['x']), np.log(group['mean']), 1)[0]:.2f})"
         label += clipped_note(group["diverged"].sum(), group["total"].sum())
-        x = _nudged(group["x"], i - (len(series) - 1) / 2, rows["x"], spec.get("log_x", True))
+        x = _nudged(group["x"], i - (len(series) - 1) / 2, rows["x"], spec.log_x)
         below, above = group["mean"] - group["ci_low"], group["ci_high"] - group["mean"]
         ax.errorbar(x, group["mean"], yerr=[below, above], **{**method_look(experiment, method).line(),
                     "color": colours[method, rest]}, markersize=5, capsize=2, elinewidth=0.8, label=label)
@@ -100,10 +101,10 @@ def _nudged(x: pd.Series, step: float, every_x: pd.Series, log: bool) -> pd.Seri
     return x + 0.012 * step * (every_x.max() - every_x.min())
 
 
-def _axes(ax, spec: dict, xs: list[float]) -> None:
+def _axes(ax, spec: MetricVsCondition, xs: list[float]) -> None:
     """Scales, x label and grid; ticks at the values drawn when they are few (a sweep's), in plain numbers."""
-    ax.set_xscale("log" if spec.get("log_x", True) else "linear")
-    if spec.get("log_y"):
+    ax.set_xscale("log" if spec.log_x else "linear")
+    if spec.log_y:
         ax.set_yscale("log")
         ax.yaxis.set_major_formatter(PLAIN)
         ax.yaxis.set_minor_formatter(_minor_labels(*ax.get_ylim()))
@@ -111,11 +112,11 @@ def _axes(ax, spec: dict, xs: list[float]) -> None:
     if len(values) <= 12:
         ax.set_xticks(values, [f"{v:g}" for v in values])
         ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel(spec.get("xlabel") or axis_label(spec["x"]))
+    ax.set_xlabel(spec.xlabel or axis_label(spec.x))
     ax.grid(True, which="both", alpha=0.3)
 
 
-def _summary(records: pd.DataFrame, metric: str, spec: dict) -> pd.DataFrame:
+def _summary(records: pd.DataFrame, metric: str, spec: MetricVsCondition) -> pd.DataFrame:
     """:func:`summarise` of the clipped runs, with each cell's count of diverged runs and of all runs."""
     values, diverged = _clipped(records, metric, spec)
     records = records.assign(**{metric: values, "diverged": diverged})
@@ -124,7 +125,7 @@ def _summary(records: pd.DataFrame, metric: str, spec: dict) -> pd.DataFrame:
     return summarise(records, metric).merge(counts.reset_index(), on=["method", "condition"])
 
 
-def _clipped(records: pd.DataFrame, metric: str, spec: dict) -> tuple[pd.Series, pd.Series]:
+def _clipped(records: pd.DataFrame, metric: str, spec: MetricVsCondition) -> tuple[pd.Series, pd.Series]:
     """``metric`` per run, each (method, condition) cell's diverged runs clipped at 10 times the cell's
     median (or ``spec.clip``); and which runs diverged.  A cell with no finite value (a metric the
     method does not have) is left as it is."""
@@ -133,7 +134,7 @@ def _clipped(records: pd.DataFrame, metric: str, spec: dict) -> tuple[pd.Series,
     for index in records.groupby(["method", "condition"], sort=False).groups.values():
         cell = values[index]
         if np.isfinite(cell).any():
-            clipped[index], diverged[index] = clip_diverged(cell, clip_level(spec, cell.median()))
+            clipped[index], diverged[index] = clip_diverged(cell, clip_level(spec.clip, cell.median()))
     return clipped, diverged
 
 
@@ -153,19 +154,19 @@ def _natural(text: str) -> list[tuple]:
             for part in re.split(r"(\d+\.?\d*)", text)]
 
 
-def paper_points(published: pd.DataFrame, spec: dict, experiment: dict, methods: set[str]) -> pd.DataFrame:
+def paper_points(published: pd.DataFrame, spec: MetricVsCondition, experiment: dict, methods: set[str]) -> pd.DataFrame:
     """The published values a figure rebuilds, as (method, x, value): the cells of ``spec.paper_table``
     and ``spec.paper_metric`` (default: ``metric``) for the figure's methods, at the x their condition
     gives (``N=500``) or, where it gives none, at ``spec.paper_x[<the cell's experiment>]``;
     ``paper_scale`` puts the paper's unit on ours (0.01: a percentage on a share)."""
-    metric = spec.get("paper_metric", spec["metric"])
-    chosen = cells(published, experiment["paper"], spec["paper_table"], metric)
+    metric = spec.paper_metric or spec.metric
+    chosen = cells(published, experiment["paper"], spec.paper_table, metric)
     chosen = chosen[chosen["method"].isin(methods) & chosen["number"].notna()]
-    at = spec.get("paper_x", {})
-    x = [at.get(scene) if value is None else value for value, scene in zip(values_of(chosen, spec["x"]),
+    at = spec.paper_x
+    x = [at.get(scene) if value is None else value for value, scene in zip(values_of(chosen, spec.x),
                                                                           chosen["experiment"])]
     points = pd.DataFrame({"method": chosen["method"], "x": pd.to_numeric(pd.Series(x, index=chosen.index)),
-                           "value": chosen["number"] * spec.get("paper_scale", 1)})
+                           "value": chosen["number"] * spec.paper_scale})
     return points.dropna()
 
 

@@ -4,7 +4,9 @@ A run's record holds ``tracks``, the tracker's output as [frame, id, x, y, w, h]
 (MOT frame numbers from 1, 0-based top-left boxes, ids from 1), and ``first_frame``
 and ``last_frame``, the MOT frames it covered (inclusive); its condition names the
 scene, ``scene=<key>``, and the experiment's ``scenes[<key>]`` is ``{kind: mot, name:
-PETS09-S2L1, root: ...}`` (``root`` defaults to :data:`replication.scenes.mot.MOT_ROOT`).
+PETS09-S2L1, root: ...}`` (``root`` defaults to :data:`replication.scenes.mot.MOT_ROOT`).  The sequence, a
+run's tracks as rows and their CLEAR MOT matches come from the
+:class:`~replication.evidence.footage.Footage` the page is given (computed below the report).
 
 Every figure draws a track in the colour :func:`track_colour` gives its id, the same
 on every panel and figure; ground truth is a thin white outline, ignore regions a
@@ -12,7 +14,7 @@ dashed grey one.
 """
 
 import textwrap
-from functools import lru_cache
+from typing import Any
 from pathlib import Path
 
 import cv2
@@ -25,13 +27,12 @@ from matplotlib.patches import Rectangle
 from PIL import Image
 
 from replication import atomic
-from replication.metrics.mot import BOX, clear_mot_matches
 from replication.condition import PREFIX, values_of
 from replication.display import method_label
+from replication.evidence.footage import Footage
 from replication.report.figures.style import save
-from replication.scenes.mot import MOT_ROOT, MotSequence, load_mot
-from replication.tasks.mot import frame_table
-from replication.report.figures.base import figure
+from replication.evidence.figures import IdentityTimeline, TrackSnapshots, TrackVideo
+from replication.report.figures.base import draws
 
 # tab10 then Dark2, both without their grey (kept for the ignore regions) and without light tints (which
 # would read as the white truth): 16 saturated colours, consecutive ids (mostly alive at the same time)
@@ -39,6 +40,7 @@ from replication.report.figures.base import figure
 ID_COLOURS = tuple(c for name in ("tab10", "Dark2") for c in plt.get_cmap(name).colors
                    if not np.allclose(c, c[0], atol=0.02))
 TRUTH, IGNORED = "white", "#b0b0b0"
+BOX = ["x", "y", "w", "h"]  # a box's columns in the truth, ignore and track tables (0-based top-left, size)
 OUTLINE = [patheffects.withStroke(linewidth=1.6, foreground="black")]  # an id's number, readable on any image
 
 
@@ -50,17 +52,6 @@ def track_colour(track_id: int) -> tuple[float, float, float]:
 def scene_key(runs: pd.DataFrame) -> str:
     """The scene (its key in the experiment's ``scenes``) of one condition's runs."""
     return values_of(runs, "scene").iloc[0]
-
-
-def mot_sequence(experiment: dict, scene_key: str) -> MotSequence:
-    """The MOT sequence of a scene of the experiment."""
-    scene = experiment["scenes"][scene_key]
-    return _load(scene["name"], scene.get("root", MOT_ROOT))
-
-
-@lru_cache(maxsize=4)
-def _load(name: str, root: str) -> MotSequence:
-    return load_mot(name, root)
 
 
 def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
@@ -89,7 +80,7 @@ def _boxes(ax, truth: pd.DataFrame, ignored: pd.DataFrame, tracks: pd.DataFrame,
                 path_effects=OUTLINE)
 
 
-def _panel(ax, sequence: MotSequence, frame: int, tracks: pd.DataFrame, fontsize: float = 5.5,
+def _panel(ax, sequence: Any, frame: int, tracks: pd.DataFrame, fontsize: float = 5.5,
            window: tuple[float, float, float, float] | None = None) -> None:
     """Frame ``frame`` of ``sequence`` with its boxes, the frame number as title; ``window`` (x0, y0, x1,
     y1 px) shows part of it."""
@@ -103,28 +94,28 @@ def _panel(ax, sequence: MotSequence, frame: int, tracks: pd.DataFrame, fontsize
     ax.set_title(f"frame {frame}", fontsize=7, pad=2)
 
 
-def _window(spec: dict, sequence: MotSequence, frames: list[int], tables: list[pd.DataFrame],
+def _window(spec: TrackSnapshots, sequence: Any, frames: list[int], tables: list[pd.DataFrame],
             margin: float = 40) -> tuple[float, float, float, float]:
     """The part of a scene's frames the snapshots show: the boxes of ``tables`` in ``frames`` with a
     ``margin`` (px) around them, or the whole frame with ``crop: false``."""
     width, height = sequence.size
     boxes = pd.concat([table[table["frame"].isin(frames)] for table in tables])[BOX].to_numpy(float)
-    if spec.get("crop", True) is False or not len(boxes):
+    if spec.crop is False or not len(boxes):
         return 0, 0, width, height
     x0, y0 = np.maximum(boxes[:, :2].min(axis=0) - margin, 0)
     x1, y1 = np.minimum((boxes[:, :2] + boxes[:, 2:]).max(axis=0) + margin, (width, height))
     return float(x0), float(y0), float(x1), float(y1)
 
 
-def _snapshot_frames(spec: dict, scene: str, run: pd.Series, n_frames: int) -> list[int]:
+def _snapshot_frames(spec: TrackSnapshots, scene: str, run: pd.Series, n_frames: int) -> list[int]:
     """The frames of a scene's snapshots: ``spec.frames`` (a list, or a list per scene key), else
     ``spec.columns`` (4) frames evenly spaced over the run's."""
-    frames = spec.get("frames")
+    frames = spec.frames
     if isinstance(frames, dict):
         frames = frames.get(scene)
     if frames is None:
         first, last = int(run["first_frame"]), int(run["last_frame"])
-        frames = np.unique(np.linspace(first, last, spec.get("columns", 4)).round().astype(int))
+        frames = np.unique(np.linspace(first, last, spec.columns).round().astype(int))
     return [int(k) for k in frames if 1 <= k <= n_frames]
 
 
@@ -132,8 +123,9 @@ CAPTION = ("Coloured boxes: the tracker's output, one colour per track id (its n
            "white: ground truth; dashed grey: regions MOTChallenge ignores.")
 
 
-@figure("track_snapshots", reads=("tracks",))
-def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(TrackSnapshots)
+def track_snapshots(records: pd.DataFrame, spec: TrackSnapshots, experiment: dict, path: Path,
+                    footage: Footage) -> Path:
     """Frames of the real video with each method's output (its first run), one row per method and condition,
     one column per frame of ``spec.frames`` (``{<scene key>: [MOT frame numbers]}`` or one list for every
     scene; by default ``spec.columns``, 4, frames evenly spaced over the run).  The panels show the part of
@@ -142,10 +134,10 @@ def track_snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     several = records["condition"].nunique() > 1
     for _, group in records.groupby("condition", sort=False):
         scene = scene_key(group)
-        sequence = mot_sequence(experiment, scene)
+        sequence = footage.mot_sequence(experiment, scene)
         runs = [run for _, run in _first_runs(group).iterrows()]
         frames = _snapshot_frames(spec, scene, runs[0], sequence.n_frames)
-        tracks = [frame_table(run) for run in runs]
+        tracks = [footage.tracks(run) for run in runs]
         window = _window(spec, sequence, frames, [sequence.truth, sequence.ignored, *tracks])
         for run, table in zip(runs, tracks):
             label = textwrap.fill(method_label(experiment, run["method"]), 24)
@@ -181,18 +173,18 @@ def _on(colour) -> str:
     return "black" if 0.299 * r + 0.587 * g + 0.114 * b > 0.5 else "white"
 
 
-def timeline_matches(sequence: MotSequence, run) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The truth of a run's frames and the CLEAR MOT matches of its tracks
-    (:func:`replication.metrics.mot.clear_mot_matches`, as the metrics count them)."""
+def timeline_matches(sequence: Any, run, footage: Footage) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The truth of a run's frames and the CLEAR MOT matches of its tracks (as the metrics count them:
+    :meth:`~replication.evidence.footage.Footage.matches`)."""
     first, last = int(run["first_frame"]), int(run["last_frame"])
     truth = _between(sequence.truth, first, last)
-    tracks, ignored = _between(frame_table(run), first, last), _between(sequence.ignored, first, last)
-    matches = clear_mot_matches(truth, tracks, ignored)
-    return truth, matches
+    tracks, ignored = _between(footage.tracks(run), first, last), _between(sequence.ignored, first, last)
+    return truth, footage.matches(truth, tracks, ignored)
 
 
-@figure("identity_timeline", reads=("tracks",))
-def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(IdentityTimeline)
+def identity_timeline(records: pd.DataFrame, spec: IdentityTimeline, experiment: dict, path: Path,
+                      footage: Footage) -> Path:
     """Which output track held which person, frame by frame: one panel per method (its first run) and
     condition, one lane per ground-truth id, a bar in the matched track's colour (its id written in it)
     where CLEAR MOT matches them (IoU >= 0.5, a match kept while it holds), a grey line where the person
@@ -200,9 +192,9 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
     panels = []
     for _, group in records.groupby("condition", sort=False):
         scene = scene_key(group)
-        sequence = mot_sequence(experiment, scene)
+        sequence = footage.mot_sequence(experiment, scene)
         for _, run in _first_runs(group).iterrows():
-            panels.append((scene, run, *timeline_matches(sequence, run)))
+            panels.append((scene, run, *timeline_matches(sequence, run, footage)))
     lanes = [max(truth["id"].nunique(), 1) for _, _, truth, _ in panels]
     fig, axes = plt.subplots(len(panels), 1, squeeze=False, height_ratios=lanes,
                              figsize=(10, 0.8 * len(panels) + 0.2 * sum(lanes)))
@@ -241,16 +233,16 @@ def identity_timeline(records: pd.DataFrame, spec: dict, experiment: dict, path:
     return save(fig, path, dpi=130)
 
 
-def _video_run(records: pd.DataFrame, spec: dict) -> pd.Series:
+def _video_run(records: pd.DataFrame, spec: TrackVideo) -> pd.Series:
     """The first run of ``spec.method`` (default: the first method) in ``spec.scene``'s condition (default:
     the first condition the method has)."""
-    method = spec.get("method", records["method"].iloc[0])
+    method = spec.method or records["method"].iloc[0]
     runs = records[records["method"] == method]
-    if "scene" in spec:
-        runs = runs[values_of(runs, "scene") == spec["scene"]]
+    if spec.scene is not None:
+        runs = runs[values_of(runs, "scene") == spec.scene]
     if runs.empty:
-        raise ValueError(f"track_video: no run of method {method!r}" + (f" on scene {spec['scene']!r}"
-                                                                        if "scene" in spec else ""))
+        raise ValueError(f"track_video: no run of method {method!r}" + (f" on scene {spec.scene!r}"
+                                                                        if spec.scene is not None else ""))
     runs = runs[runs["condition"] == runs["condition"].iloc[0]]
     return runs.sort_values("repetition").iloc[0]
 
@@ -259,7 +251,7 @@ def _bgr(colour) -> tuple[int, int, int]:
     return tuple(round(255 * c) for c in to_rgb(colour)[::-1])
 
 
-def video_frame(sequence: MotSequence, frame: int, tracks: pd.DataFrame, width: int) -> np.ndarray:
+def video_frame(sequence: Any, frame: int, tracks: pd.DataFrame, width: int) -> np.ndarray:
     """Frame ``frame`` scaled to ``width`` px with its ignore regions (grey), truth (white) and output boxes
     (coloured by id, numbered), as RGB."""
     scale = width / sequence.size[0]
@@ -319,8 +311,8 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float, still: int = 14)
     return path
 
 
-@figure("track_video", reads=("tracks",))
-def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(TrackVideo)
+def track_video(records: pd.DataFrame, spec: TrackVideo, experiment: dict, path: Path, footage: Footage) -> Path:
     """An animated GIF of one run, and a PNG poster as the figure: its first frame with an output box.
 
     The run is the first of ``spec.method`` (default: the first method) on ``spec.scene`` (a scene key;
@@ -330,14 +322,14 @@ def track_video(records: pd.DataFrame, spec: dict, experiment: dict, path: Path)
     ``link: <name>.gif`` in the figure's spec for the report page to link it.
     """
     run = _video_run(records, spec)
-    sequence = mot_sequence(experiment, run[f"{PREFIX}scene"])
-    first, last = spec.get("frames", (int(run["first_frame"]), int(run["first_frame"]) + 99))
+    sequence = footage.mot_sequence(experiment, run[f"{PREFIX}scene"])
+    first, last = spec.frames or (int(run["first_frame"]), int(run["first_frame"]) + 99)
     first = max(int(first), int(run["first_frame"]), 1)
     last = min(int(last), int(run["last_frame"]), sequence.n_frames)
-    tracks = frame_table(run)
-    animation = path.parent / spec.get("link", path.with_suffix(".gif").name)
-    frames = [video_frame(sequence, k, tracks, spec.get("width", 384)) for k in range(first, last + 1)]
-    write_gif(frames, animation, spec.get("fps", sequence.frame_rate))
+    tracks = footage.tracks(run)
+    animation = path.parent / (spec.link or path.with_suffix(".gif").name)
+    frames = [video_frame(sequence, k, tracks, spec.width) for k in range(first, last + 1)]
+    write_gif(frames, animation, sequence.frame_rate if spec.fps is None else spec.fps)
     width, height = sequence.size
     shown = _between(tracks, first, last)["frame"]
     poster = int(shown.min()) if len(shown) else first

@@ -8,16 +8,17 @@ import pandas as pd
 
 from replication import atomic
 from replication.qmc import discrepancy, point_set
-from replication.report.figures.base import figure
+from replication.evidence.figures import PointSets
+from replication.report.figures.base import draws
 
 PANELS = (("random", "random (uniform)"), ("halton", "Halton"), ("good_cos", "good point set, r = 2cos(2 pi i / p)"),
           ("good_exp", "good point set, r = exp(i)"))
 
 
-@figure("point_sets")
-def point_sets(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(PointSets)
+def point_sets(records: pd.DataFrame, spec: PointSets, experiment: dict, path: Path) -> Path:
     """``spec.n`` points in [0, 1)^2 of each set, with the centred L2 discrepancy in the title."""
-    n = int(spec.get("n", 400))
+    n = spec.n
     fig, axes = plt.subplots(1, len(PANELS), figsize=(3.2 * len(PANELS), 3.4))
     for ax, (name, title) in zip(axes, PANELS):
         points = np.random.default_rng(0).random((n, 2)) if name == "random" else point_set(name, n, 2)

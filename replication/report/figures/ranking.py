@@ -9,19 +9,20 @@ import pandas as pd
 
 from replication.evidence.ranking import rankings, unreliable
 from replication.report.figures.style import OUTCOME_COLOURS, NothingToDraw, axis_label, save
-from replication.report.figures.base import figure
+from replication.evidence.figures import RankingFigure
+from replication.report.figures.base import draws
 
 LUMA = np.array([0.299, 0.587, 0.114])  # a colour's lightness: dark segments take white text
 
 
-@figure("ranking")
-def ranking(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(RankingFigure)
+def ranking(records: pd.DataFrame, spec: RankingFigure, experiment: dict, path: Path) -> Path:
     """One row of two panels per ranking (:func:`~replication.evidence.ranking.rankings` of ``spec``):
     left, stacked bars of P(rank = k) per method, best first, with its P(best) and 95% rank interval;
     right, the matrix of P(row beats column).  A ranking that is not reliable says why above it."""
-    found = rankings(records, spec)
+    found = rankings(records, spec.metric, spec.over, spec.by)
     if not found:
-        raise NothingToDraw(f"figure {spec.get('name', 'ranking')!r}: no two methods ran on the same sequences")
+        raise NothingToDraw(f"figure {spec.name!r}: no two methods ran on the same sequences")
     heights = [max(2.4, 0.42 * len(r.methods) + 1.4) for r in found.values()]
     fig, axes = plt.subplots(len(found), 2, figsize=(12, sum(heights)), squeeze=False,
                              gridspec_kw={"height_ratios": heights, "width_ratios": [1.1, 1]})
@@ -46,7 +47,7 @@ def ranking(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> 
         left.invert_yaxis()  # best on top
         left.set_xlim(0, 1)
         left.set_xlabel("P(rank = k), k written in its segment (1 = best)", fontsize=8)
-        what = (f"{axis_label(spec['metric'])}: mean over {len(ranked.sequences)} sequences x "
+        what = (f"{axis_label(spec.metric)}: mean over {len(ranked.sequences)} sequences x "
                 f"{ranked.runs} run(s)")
         title = textwrap.fill(", ".join(filter(None, [group, what])), 75)
         caveat = unreliable(ranked, experiment)

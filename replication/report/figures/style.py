@@ -8,7 +8,6 @@ Line style and marker keep more methods than colours apart, and in print.  A pap
 hollow diamonds in the method's colour.
 """
 
-import re
 import zlib
 from itertools import product
 from pathlib import Path
@@ -20,6 +19,7 @@ from matplotlib.colors import to_rgb
 from replication import atomic
 from replication.display import COLOURS, LINES, MARKERS, Look, asked_look
 from replication.errors import ConfigError
+from replication.evidence.quantities import label as metric_label
 from replication.filters.registry import builder
 
 PALETTE = tuple(COLOURS.values())
@@ -62,26 +62,7 @@ def shades(colour: str, n: int) -> list[tuple]:
     return [tuple(rgb * (1 + t) if t < 0 else rgb + (1 - rgb) * t) for t in np.linspace(-0.45, 0.55, n)]
 
 
-LABELS = {  # metric, per-frame series or swept variable -> axis label
-    "rmse": "RMSE",
-    "ms_per_step": "time per step (ms)",
-    "ms_per_frame": "time per frame (ms)",
-    "evaluations_per_step": "likelihood evaluations per step",
-    "filter_s": "filtering time (s)",
-    "fps": "frames per second",
-    "mean_ess": "mean effective sample size",
-    "resample_count": "resamplings",
-    "resample_rate": "resampling rate (% of steps)",
-    "mean_cle": "mean centre location error (px)",
-    "precision20": "precision at 20 px",
-    "success_auc": "success AUC",
-    "mean_error_per_target": "mean error per target (px)",
-    "lost_targets": "lost targets",
-    "failed": "share of failed runs",
-    "switches": "identity switches",
-    "mota": "MOTA",
-    "correct_frames": "share of frames with {rule}",
-    "tracked_to_end": "share of runs tracked to the end ({rule})",
+LABELS = {  # per-frame series and swept variables -> axis label (a metric's are evidence's: quantities.label)
     "cle": "centre location error (px)",
     "iou": "overlap (IoU)",
     "dx": "column deviation from the truth (px)",
@@ -100,19 +81,13 @@ LABELS = {  # metric, per-frame series or swept variable -> axis label
     "tau1": r"position-matrix step $\tau_1$",
     "ess_threshold": "ESS threshold (share of N)",
     "resampling": "resampling scheme",
-    "iou>=0.5": "IoU ≥ 0.5",
-    "iou>0": "IoU > 0",
-    "cle<=20": "centre error ≤ 20 px",
-    "cle<=10": "centre error ≤ 10 px",
 }
 
 
 def axis_label(name: str) -> str:
-    """The words for a metric, series or swept variable; ``metric[rule]`` reads its rule; else the name."""
-    base, rule = re.fullmatch(r"([^\[]*)(?:\[(.*)\])?", name).groups()
-    if rule is None:
-        return LABELS.get(name, name)
-    return LABELS[base].format(rule=LABELS.get(rule, rule)) if base in LABELS else name
+    """The words for a metric (:func:`replication.evidence.quantities.label`, which reads ``metric[rule]``),
+    a per-frame series or a swept variable; else the name."""
+    return LABELS.get(name) or metric_label(name) or name
 
 
 def clipped_note(diverged: int, runs: int) -> str:

@@ -10,23 +10,26 @@ from matplotlib.colors import to_rgb
 
 from replication.boxes import centres
 from replication.display import method_label
-from replication.evidence.aggregate import scene_of, sequence_seen
+from replication.evidence.aggregate import scene_of
 from replication.evidence.attributes import absent, attribute_scores
-from replication.metrics import multi
+from replication.evidence.footage import Footage
 from replication.report.figures.style import (
     NothingToDraw, axis_label, clipped_note, method_look, save,
 )
-from replication.report.figures.base import figure
+from replication.evidence.figures import (
+    AttributeMap, EncounterStrip, ModeStrip, OtbCurves, OutsideCurve, PerFrameCurve, Snapshots, Track,
+)
+from replication.report.figures.base import draws
 
 
 def _by_condition(records: pd.DataFrame):
     return list(records.groupby("condition", sort=False))
 
 
-@figure("per_frame_curve", reads=("per_frame",))
-def per_frame_curve(bands: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(PerFrameCurve)
+def per_frame_curve(bands: pd.DataFrame, spec: PerFrameCurve, experiment: dict, path: Path) -> Path:
     """Mean and 10-90% band over runs of a per-frame series (``spec.series``), one panel per condition
-    (:func:`~replication.evidence.curves.per_frame_band`); methods that do not record the series are left out.
+    (:func:`~replication.runner.curves.per_frame_band`); methods that do not record the series are left out.
 
     A run diverged where it is not finite or beyond ``spec.clip`` (by default 10
     times the largest median over runs of any method at any frame, in size: a
@@ -46,7 +49,7 @@ def per_frame_curve(bands: pd.DataFrame, spec: dict, experiment: dict, path: Pat
                     + clipped_note(band["diverged"].iloc[0], band["runs"].iloc[0]))
             ax.fill_between(frames, band["low"], band["high"], color=look.colour, alpha=0.15)
         ax.set_title(condition, fontsize=9)
-        ax.set_ylabel(spec.get("ylabel") or axis_label(spec["series"]))
+        ax.set_ylabel(spec.ylabel or axis_label(spec.series))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     axes[-1, 0].set_xlabel("frame")
@@ -57,18 +60,19 @@ def _first_runs(group: pd.DataFrame) -> pd.DataFrame:
     return group.sort_values("repetition").groupby("method", sort=False).head(1)
 
 
-def _sequence(experiment: dict, condition_records: pd.DataFrame):
+def _sequence(experiment: dict, condition_records: pd.DataFrame, footage: Footage):
     """The video a condition's first runs saw (one per method, the same repetition) and the targets they track."""
-    return sequence_seen(experiment, condition_records), condition_records["per_frame"].iloc[0]["targets"]
+    return footage.seen(experiment, condition_records), condition_records["per_frame"].iloc[0]["targets"]
 
 
-@figure("track", reads=("per_frame",))
-def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(Track)
+def track(records: pd.DataFrame, spec: Track, experiment: dict, path: Path,
+          footage: Footage) -> Path:
     """Centre x and y against the frame for the first run of each method, beside the truth."""
     groups = _by_condition(records)
     fig, axes = plt.subplots(len(groups), 2, figsize=(9, 2.6 * len(groups)), squeeze=False)
     for row, (condition, group) in zip(axes, groups):
-        sequence, chosen = _sequence(experiment, group)
+        sequence, chosen = _sequence(experiment, group, footage)
         truth = sequence.truth[:, chosen]
         centre = truth[..., :2] + truth[..., 2:] / 2
         frames = np.arange(1, len(centre) + 1)
@@ -89,14 +93,15 @@ def track(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Pa
     return save(fig, path)
 
 
-def _frames(spec: dict, scene: str, n_frames: int) -> list[int]:
+def _frames(spec: Snapshots, scene: str, n_frames: int) -> list[int]:
     """Snapshot frames (0-based): one list for every scene, or a list per scene name."""
-    frames = spec["frames"][scene] if isinstance(spec["frames"], dict) else spec["frames"]
+    frames = spec.frames[scene] if isinstance(spec.frames, dict) else spec.frames
     return [k for k in frames if k < n_frames]
 
 
-@figure("snapshots", reads=("per_frame",))
-def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(Snapshots)
+def snapshots(records: pd.DataFrame, spec: Snapshots, experiment: dict, path: Path,
+              footage: Footage) -> Path:
     """Snapshot grids, one block per condition; truth white edged in black, each method's first run in
     its colour.
 
@@ -105,13 +110,13 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
     """
     blocks = []
     for condition, group in _by_condition(records):
-        sequence, chosen = _sequence(experiment, group)
+        sequence, chosen = _sequence(experiment, group, footage)
         frames = _frames(spec, scene_of(experiment, group), sequence.n_frames)
         runs = list(_first_runs(group).iterrows())
         grid = [[_snapshot(sequence, chosen, np.array(run["per_frame"]["box"]), k,
                            method_look(experiment, run["method"]).colour) for _, run in runs] for k in frames]
         labels = [method_label(experiment, run["method"]) for _, run in runs]
-        if spec.get("rows") != "frames":
+        if spec.rows != "frames":
             grid = [list(column) for column in zip(*grid)]
         blocks.append((condition, frames, labels, grid))
     n_rows = sum(len(grid) for *_, grid in blocks)
@@ -121,7 +126,7 @@ def snapshots(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
         ax.axis("off")
     row = 0
     for condition, frames, labels, grid in blocks:
-        down, across = (frames, labels) if spec.get("rows") == "frames" else (labels, frames)
+        down, across = (frames, labels) if spec.rows == "frames" else (labels, frames)
         for r, images in enumerate(grid):
             for c, image in enumerate(images):
                 ax = axes[row + r, c]
@@ -147,17 +152,18 @@ def _snapshot(sequence, chosen: list[int], boxes: np.ndarray, k: int, colour: st
     return image
 
 
-@figure("mode_strip", reads=("strip", "per_frame"))
-def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(ModeStrip)
+def mode_strip(records: pd.DataFrame, spec: ModeStrip, experiment: dict, path: Path,
+               footage: Footage) -> Path:
     """The marginal posterior of one target over x or y, frame by frame (first run of each method),
     with every target's true coordinate drawn over it: does a hidden target keep both modes?"""
     runs = list(_first_runs(records[records["strip"].notna()]).iterrows())
     if not runs:
-        raise NothingToDraw(f"figure {spec.get('name', 'mode_strip')!r}: no run recorded a strip (a scene's "
+        raise NothingToDraw(f"figure {spec.name!r}: no run recorded a strip (a scene's "
                             "strip: {target: ...} block, bis_pf's exp1_3123)")
     fig, axes = plt.subplots(len(runs), 1, figsize=(7, 2.6 * len(runs)), squeeze=False)
     for ax, (_, run) in zip(axes[:, 0], runs):
-        sequence, _ = _sequence(experiment, run.to_frame().T)
+        sequence, _ = _sequence(experiment, run.to_frame().T, footage)
         density = np.array(run["strip"]["density"])  # (T - 1, bins)
         axis = "xy".index(run["strip"]["axis"])
         ax.imshow(density.T, origin="lower", aspect="auto", cmap="magma",
@@ -165,7 +171,7 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
         truth = centres(sequence.truth[1:])[..., axis]
         for m in range(truth.shape[1]):
             ax.plot(np.arange(1, len(truth) + 1), truth[:, m], lw=0.8, ls="--", label=f"truth {m + 1}")
-        first, last = spec.get("window", (None, None))
+        first, last = spec.window or (None, None)
         if first is not None:
             ax.axvspan(first, last, color="w", alpha=0.08)
         target = run["strip"]["target"] + 1
@@ -176,11 +182,11 @@ def mode_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) 
     return save(fig, path)
 
 
-@figure("otb_curves", reads=("per_frame",))
-def otb_curves(curves: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(OtbCurves)
+def otb_curves(curves: pd.DataFrame, spec: OtbCurves, experiment: dict, path: Path) -> Path:
     """OTB one-pass precision and success plots over every sequence and run, one line per method.
 
-    Each curve is the mean over runs of the per-run curve (:func:`~replication.evidence.curves.otb_curves`),
+    Each curve is the mean over runs of the per-run curve (:func:`~replication.runner.curves.otb_curves`),
     so every sequence weighs the same, as in OTB's toolkit; the legend gives precision at 20 px and the
     success AUC.
     """
@@ -197,16 +203,17 @@ def otb_curves(curves: pd.DataFrame, spec: dict, experiment: dict, path: Path) -
     return save(fig, path)
 
 
-@figure("attribute_map")
-def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(AttributeMap)
+def attribute_map(records: pd.DataFrame, spec: AttributeMap, experiment: dict, path: Path,
+                  footage: Footage) -> Path:
     """OTB's per-attribute view as heat maps, methods down and attributes across: precision at 20 px,
     then success AUC, each the mean over the sequences carrying the attribute (under its code: how many,
     or the one sequence by name); the best method of each attribute is framed.
     """
-    scores = attribute_scores(records, experiment)
+    scores = attribute_scores(records, experiment, footage)
     rows = list(dict.fromkeys(zip(scores["method"], scores["series"])))
     codes = list(dict.fromkeys(scores["attribute"]))
-    panels = [("precision20", "precision at 20 px"), ("success_auc", "success AUC")]
+    panels = [(metric, axis_label(metric)) for metric in ("precision20", "success_auc")]
     fig, axes = plt.subplots(len(panels), 1, figsize=(2.5 + 0.75 * max(len(codes), 4), 2 * (1.2 + 0.35 * len(rows))),
                              squeeze=False)
     if scores.empty:
@@ -235,33 +242,34 @@ def attribute_map(records: pd.DataFrame, spec: dict, experiment: dict, path: Pat
         ax.set_yticks(range(len(rows)), labels, fontsize=7)
         ax.set_title(f"{name} per attribute (mean over the sequences carrying it; best framed)", fontsize=9)
         fig.colorbar(image, ax=ax, fraction=0.03, pad=0.02)
-    missing = absent(scores)
+    missing = absent(scores, footage.meanings)
     if missing:
         axes[-1, 0].set_xlabel(f"no sequence here carries {', '.join(missing)}", fontsize=7)
     return save(fig, path)
 
 
-@figure("encounter_strip", reads=("per_frame",))
-def encounter_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(EncounterStrip)
+def encounter_strip(records: pd.DataFrame, spec: EncounterStrip, experiment: dict, path: Path,
+                    footage: Footage) -> Path:
     """Why the per-identity error grows, for the first run of each method: above, its per-identity and
     identity-free error per frame; below, one row per pair of targets that comes within ``spec.distance`` px
     (a box width) of each other, grey while they are that close, a red tick where an estimate starts to sit
     on the other target of the pair (the frame's optimal assignment): an identity swap."""
-    distance = spec.get("distance", 20.0)
+    distance = spec.distance
     runs = _first_runs(records)
-    sequence, chosen = _sequence(experiment, records)
+    sequence, chosen = _sequence(experiment, records, footage)
     truth = centres(sequence.truth[:, chosen])
     apart = np.linalg.norm(truth[:, :, None] - truth[:, None, :], axis=-1)
     pairs = [(i, j) for i, j in zip(*np.triu_indices(len(chosen), 1)) if (apart[:, i, j] < distance).any()]
     if not pairs:
-        raise NothingToDraw(f"figure {spec.get('name')!r}: no two targets come within {distance:g} px")
+        raise NothingToDraw(f"figure {spec.name!r}: no two targets come within {distance:g} px")
     row_of = {pair: k for k, pair in enumerate(sorted(pairs, key=lambda p: np.argmax(apart[:, p[0], p[1]] < distance)))}
     frames = np.arange(len(truth))
     fig, axes = plt.subplots(2 * len(runs), 1, figsize=(10, len(runs) * (1.6 + 0.05 * len(pairs))), squeeze=False,
                              gridspec_kw={"height_ratios": [1, max(1.5, 0.05 * len(pairs))] * len(runs)}, sharex=True)
     for (_, run), top, strip in zip(runs.iterrows(), axes[0::2, 0], axes[1::2, 0]):
         estimates = centres(np.array(run["per_frame"]["box"], dtype=float))
-        assigned, near = multi.assignments(estimates, truth)
+        assigned, near = footage.assignments(estimates, truth)
         top.plot(frames, np.linalg.norm(estimates - truth, axis=-1).mean(axis=1), color="C3", lw=1,
                  label="per identity")
         top.plot(frames, near.mean(axis=1), color="C0", lw=1, label="identity-free")
@@ -284,10 +292,10 @@ def encounter_strip(records: pd.DataFrame, spec: dict, experiment: dict, path: P
     return save(fig, path)
 
 
-@figure("outside_curve", reads=("per_frame",))
-def outside_curve(shares: pd.DataFrame, spec: dict, experiment: dict, path: Path) -> Path:
+@draws(OutsideCurve)
+def outside_curve(shares: pd.DataFrame, spec: OutsideCurve, experiment: dict, path: Path) -> Path:
     """Per frame, the share of targets whose estimated centre lies outside the image (the filter's own state,
-    never clipped), mean over runs, per method (:func:`~replication.evidence.curves.outside_share`): a
+    never clipped), mean over runs, per method (:func:`~replication.runner.curves.outside_share`): a
     tracker that runs off the frame shows it here."""
     fig, ax = plt.subplots(figsize=(7, 2.8))
     for method, share in shares.groupby("method", sort=False):

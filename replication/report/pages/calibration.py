@@ -1,19 +1,6 @@
-"""``reports/calibration.csv`` and ``reports/calibration/index.html``: how often each verdict rule errs.
+"""``reports/calibration/index.html``: how often each verdict rule errs, drawn from the calibration table
+(:func:`replication.evidence.calibration.calibrate`'s, kept by :mod:`replication.report.calibration`)."""
 
-The table is :func:`replication.evidence.calibration.calibrate`'s: every rule
-simulated through the code that decides, under normal, heavy-tailed and skewed
-noise, at the run and check counts the scales use.  It takes minutes, so it is
-kept beside a note of the code and replications that made it
-(``calibration.json``) and made again only when a module the calibration
-runs (``replication/evidence/calibration.py`` and what it imports) changes or
-more replications are asked for:
-``make replicate`` reuses it.
-
-    python -m replication.report.pages.calibration [reports=DIR] [replications=N] [force=true]
-"""
-
-import json
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -22,47 +9,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-from omegaconf import OmegaConf  # noqa: E402
-from tqdm.auto import tqdm  # noqa: E402
 
 from replication import atomic  # noqa: E402
-from replication.evidence import calibration  # noqa: E402
 from replication.evidence.inference import detectable  # noqa: E402
-  # noqa: E402
-from replication.paths import CONF_DIR, resolve  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
-from replication.runner.provenance import run_code_digest  # noqa: E402
 from replication.evidence.settings import INFERENCE  # noqa: E402
-
-CSV = "calibration.csv"
-NOTE = "calibration.json"
-
-
-def evidence_digest() -> str:
-    """SHA-256 (12 hex digits) of the deciding code the calibration simulates: its module and every module it
-    imports (:func:`~replication.runner.provenance.run_code_digest`)."""
-    return run_code_digest(("evidence/calibration.py",))
-
-
-def load_or_calibrate(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> pd.DataFrame:
-    """The stored table when the deciding code, the inference setting and the replications are those that made
-    it, else a new one."""
-    csv, note = reports / CSV, reports / NOTE
-    wanted = {"evidence": evidence_digest(), "replications": replications, "seed": calibration.SEED,
-              "inference": INFERENCE.as_dict()}
-    if not force and csv.exists() and note.exists() and json.loads(note.read_text()) == wanted:
-        return read(csv)
-    with tqdm(total=len(calibration.cases()), desc="calibration", unit="rule") as bar:
-        table = calibration.calibrate(replications, progress=lambda done, total: bar.update(1))
-    reports.mkdir(parents=True, exist_ok=True)
-    atomic.save(csv, lambda tmp: table.to_csv(tmp, index=False))
-    atomic.write_text(note, json.dumps(wanted, indent=1))
-    return table
-
-
-def read(path: Path) -> pd.DataFrame:
-    """The table back from its CSV ('null' is a truth, not a missing value)."""
-    return pd.read_csv(path, keep_default_na=False, na_values=[""])
 
 
 def failures(table: pd.DataFrame, standard_errors: float = 2.0, control: bool = False) -> pd.DataFrame:
@@ -122,9 +73,9 @@ def draw_power(table: pd.DataFrame, path: Path) -> None:
     plt.close(fig)
 
 
-def write_calibration(reports: Path, replications: int = calibration.REPLICATIONS, force: bool = False) -> Path:
-    """The calibration page (and its table, made only when stale)."""
-    table = load_or_calibrate(reports, replications, force)
+def write_calibration_page(table: pd.DataFrame, reports: Path) -> Path:
+    """The calibration page of ``table`` (:func:`replication.evidence.calibration.calibrate`'s) under
+    ``<reports>/calibration/``."""
     out = reports / "calibration"
     out.mkdir(parents=True, exist_ok=True)
     draw_null_rates(table, out / "null_rates.png")
@@ -138,20 +89,3 @@ def write_calibration(reports: Path, replications: int = calibration.REPLICATION
         rows=len(table), floor=2.0 ** -5, equivalence_alpha=INFERENCE.equivalence_alpha,
         detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page
-
-
-def main(argv: list[str]) -> None:
-    options = dict(a.split("=", 1) for a in argv if "=" in a)
-    unknown = set(options) - {"reports", "replications", "force"}
-    if unknown or len(options) != len(argv):
-        print("usage: python -m replication.report.pages.calibration [reports=DIR] [replications=N] [force=true]",
-              file=sys.stderr)
-        raise SystemExit(2)
-    reports = resolve(options.get("reports") or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    page = write_calibration(reports, int(options.get("replications", calibration.REPLICATIONS)),
-                             options.get("force", "false").lower() == "true")
-    print(f"calibration: {page}")
-
-
-if __name__ == "__main__":
-    main(sys.argv[1:])

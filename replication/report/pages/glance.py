@@ -2,7 +2,7 @@
 record) and in this report, whether it survives every reading, and its deciding number on one common scale.
 
 The common scale is ours / paper's: the deciding check's estimate and interval over the paper's own value
-of the same number (:attr:`~replication.evidence.claims.Check.paper`: a sized claim's gap, a cell's
+of the same number (:attr:`~replication.evidence.checks.Check.paper`: a sized claim's gap, a cell's
 published value, a threshold's bound), so 1 is what the paper says, 0 no effect and a negative number the
 other way round.  A check for which the paper quotes no number (a sign-only claim) gets no mark: its line
 still gives its verdicts.  The figure heads the index page and the PDF.
@@ -20,7 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
 from replication import atomic  # noqa: E402
-from replication.evidence.claims import Check, Paper  # noqa: E402
+from replication.evidence.checks import Check  # noqa: E402
+from replication.evidence.claims import Paper  # noqa: E402
 from replication.evidence.scorecard import ClaimRow  # noqa: E402
 from replication.evidence.statistics import Estimate, said_level  # noqa: E402
 from replication.evidence.verdict import Outcome  # noqa: E402

@@ -24,9 +24,9 @@ from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.scales import QUICK_REPORTS, SCALES, page_link
-from replication.evidence.scorecard import cell_tallies, claim_rows, claims_frame, owner_of_cells, tally
+from replication.evidence.scorecard import Scorecard, tally
 from replication.evidence.schema import Summary
-from replication.evidence.summary import counts, experiment_configs, load_summaries, summary_table
+from replication.evidence.summary import counts, load_summaries
 from replication.evidence.settings import rules
 
 TITLE = "Particle-filter tracking papers: replication report"
@@ -72,17 +72,13 @@ def write_index(reports: Path, published_values: str | Path | None = None) -> Pa
                    if name in pages[scale]]
     own = [_entry(name, summary) for scale in SCALES
            for name, summary in load_summaries(reports, own=True, scales=(scale,)).items()]
-    published = load_published(str(published_path(published_values)))
     papers = load_papers()
-    rows = claim_rows(papers, summaries)
+    card = Scorecard.of(summaries, papers, load_published(str(published_path(published_values))))
+    rows, cells, tallies = card.rows, card.cells, card.tallies
     record = recorded(reports, papers)
-    cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
     reports.mkdir(parents=True, exist_ok=True)
-    shown = cells.drop(columns=["link_text"])
-    atomic.save(reports / "summary.csv", lambda tmp: shown.to_csv(tmp, index=False))
-    tallies = cell_tallies(cells)
-    claims = claims_frame(rows, cells, tallies)
-    atomic.save(reports / "claims.csv", lambda tmp: claims.to_csv(tmp, index=False))
+    atomic.save(reports / "summary.csv", lambda tmp: card.cell_table.to_csv(tmp, index=False))  # exports, never read
+    atomic.save(reports / "claims.csv", lambda tmp: card.claims.to_csv(tmp, index=False))
     glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
     page = reports / "index.html"
     atomic.write_text(

@@ -11,6 +11,7 @@ with its interval and the best case for the paper: the case that comes
 closest to the claim holding, with its number.
 """
 
+from dataclasses import replace
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -19,10 +20,8 @@ import pandas as pd
 from omegaconf import DictConfig, OmegaConf
 
 from replication import atomic
-from replication.evidence.claims import Claim, ClaimTest, evaluate, load_papers
-from replication.evidence.multiverse import BASIS, READING, Case, Robustness
-from replication.evidence.published import load_published, published_path
-from replication.evidence.schema import Summary
+from replication.evidence.judge import MultiverseJudgement, Universes
+from replication.evidence.multiverse import READING, Robustness
 from replication.evidence.settings import rules
 from replication.evidence.statistics import said_level
 from replication.paths import resolve
@@ -30,46 +29,9 @@ from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.scales import index_from, report_folder
 from replication.report.figures.style import OUTCOME_COLOURS
-from replication.evidence.tables import TableKind
-from replication.runner.multiverse import Multiverse
-from replication.runner.store import Store
-
-def evaluate_multiverse(multiverse: Multiverse, store_of, published: pd.DataFrame) -> tuple[list[Robustness], int]:
-    """Every claim of the paper tested in every universe with each of its readings on the multiverse's
-    experiments (``store_of(experiment, universe)``: where that universe's runs of it are); and how many
-    records were read (a run several universes share, in each)."""
-    claims = [c for paper in load_papers() if paper.key == multiverse.paper for c in paper.claims]
-    cases: dict[str, list[Case]] = {c.id: [] for c in claims}
-    n_records = 0
-    for universe in multiverse.universes:
-        results = {}
-        for name in multiverse.experiments:
-            experiment = multiverse.experiment_configs[universe.name, name]
-            records = store_of(name, universe).load(multiverse.runs[universe.name, name])
-            n_records += len(records)
-            tables = _tables(name, experiment, records, claims, published)
-            for claim, readings in evaluate(name, experiment, records, tables, published).items():
-                results.setdefault(claim, {}).update(readings)
-        for claim in claims:
-            for reading in claim.readings:
-                stored = results.get(claim.id, {}).get(reading.name)
-                if stored is not None:
-                    scoring = ((BASIS, reading.compared_at), (READING, reading.name))
-                    cases[claim.id].append(Case(universe.name, universe.picks + scoring, stored))
-    return [Robustness(claim, tuple(cases[claim.id])) for claim in claims if cases[claim.id]], n_records
 
 
-def _tables(name: str, experiment: dict, records: pd.DataFrame, claims: list[Claim], published: pd.DataFrame):
-    """The tables the claims' ``cells`` readings on ``name`` judge, built from ``records`` (only those)."""
-    wanted = {t for c in claims for r in c.readings if r.experiment == name
-              for t in ClaimTest.of(r.test, experiment).tables}
-    specs = [s for s in experiment.get("report", {}).get("tables", []) if s["name"] in wanted]
-    if records.empty:
-        return {}
-    return {s["name"]: TableKind.of(s, experiment, published).build(records) for s in specs}
-
-
-def draw(robustness: list[Robustness], multiverse: Multiverse, path: Path) -> None:
+def draw(robustness: list[Robustness], multiverse: Universes, path: Path) -> None:
     """A forest plot per claim: the deciding check of its default case, in every universe under the claim's
     first reading, with the interval of the test that decided it (its level in the panel's title), coloured by
     verdict; the claim's line (the paper's value, a bound, zero difference or an allowed margin) dashed."""
@@ -115,34 +77,28 @@ def _headline(robustness: Robustness) -> str | None:
     return deciding.what if deciding and deciding.estimate is not None else None
 
 
-def write_multiverse_report(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
-                            store_of=None) -> Path:
-    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``): the choices, the universes
-    run, each claim's robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for
-    the scorecard.  ``store_of(experiment, universe)`` holds the runs (the store by default; the paper-scale
-    record's universe, or the record beneath the store: :mod:`replication.record.layer`)."""
+def write_multiverse_report(cfg: DictConfig, multiverse: Universes, judged: MultiverseJudgement,
+                            overrides: tuple[str, ...] = ()) -> Path:
+    """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``), drawn from the multiverse's
+    judgement (:func:`replication.evidence.judge.judge_multiverse`): the choices, the universes run, each claim's
+    robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard."""
     out = report_folder(resolve(cfg.reports), multiverse.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
-    published = load_published(str(published_path(cfg.published_values)))
-    store_of = store_of or (lambda name, universe: Store(resolve(cfg.store), name))
-    robustness, n_records = evaluate_multiverse(multiverse, store_of, published)
+    robustness = judged.robustness
     draw(robustness, multiverse, out / "readings.png")
     frame = pd.DataFrame([{"claim_id": r.claim.id, "universe": c.universe, **{k: v for k, v in c.picks},
                            "verdict": c.verdict.outcome.value, "why": c.verdict.why,
                            "number": c.deciding.number if c.deciding else ""} for r in robustness for c in r.cases])
     atomic.save(out / "cases.csv", lambda tmp: frame.to_csv(tmp, index=False))
-    n_runs = sum(len(runs) for runs in multiverse.runs.values())  # per universe: a shared run in each
     page = out / "index.html"
     atomic.write_text(page, render(
-        "multiverse.html.j2", title=cfg.experiment.get("title", multiverse.name), multiverse=multiverse,
-        robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=n_runs,
+        "multiverse.html.j2", title=judged.summary.title, multiverse=multiverse,
+        robustness=robustness, figure=(out / "readings.png").exists(), rules=rules(), n_runs=judged.summary.n_runs,
         home=index_from(multiverse.name, cfg.scale),
         scale_note=scale_note(cfg.scale), config=OmegaConf.to_yaml(cfg.experiment),
         command=" ".join([f"python -m replication experiment={multiverse.name} scale={cfg.scale}",  # what made it
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
     figures = ({"name": "readings", "file": "readings.png",
                 "title": "Each claim's deciding number in every universe (its test's interval, coloured by verdict)"},)
-    Summary(multiverse.name, cfg.experiment.get("title", multiverse.name), multiverse.paper, cfg.scale, n_records,
-            n_runs, figures=figures if (out / "readings.png").exists() else (),
-            multiverse={r.claim.id: r.as_result() for r in robustness}).write(out)
+    replace(judged.summary, figures=figures if (out / "readings.png").exists() else ()).write(out)
     return page

@@ -44,7 +44,7 @@ def write_status(out: Path, manifest: Manifest, stale: dict[str, int], designed:
                                "designed": designed.get(name, 0),
                                "minutes": entries[name].minutes, "cpu_minutes": round(entries[name].wall_s / 60, 1),
                                "thread_cpu_minutes": entries[name].cpu_s and round(entries[name].cpu_s / 60, 1),
-                               "load_1m": entries[name].load_1m,
+                               "load_1m": entries[name].load_1m, "reference_ms": entries[name].reference_ms,
                                "before": _before(entries[name].before)} for name, n in stale.items()},
         "profile": profile,
     }
