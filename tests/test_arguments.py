@@ -48,7 +48,7 @@ def test_a_bad_argument_is_one_line_naming_the_known_keys(argv, said, capsys):
 @pytest.mark.parametrize("module, argv, said", [
     ("replication.scenes.__main__", ["experiment=bis_pf", "boxes=yes"], "boxes must be true or false"),
     ("replication.report.pdf", ["report=x"], "unknown option 'report' for python -m replication.report.pdf"),
-    ("replication.report.pages.calibration", ["replications=many"], "replications must be an integer"),
+    ("replication.report.calibration", ["replications=many"], "replications must be an integer"),
     ("replication.record.__main__", ["experiment=nope"], "unknown experiment 'nope'"),
     ("replication.record.__main__", ["scale=quick"], "unknown option 'scale' for record; known: experiment=, store="),
     ("replication.record.verify", ["n_jobs=0"], "verify: n_jobs must be a positive integer"),

@@ -255,7 +255,7 @@ def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     from conftest import SMALL
 
     from replication.evidence.published import load_published
-    from replication.evidence.tables.rating import Rating
+    from replication.evidence.tables import TableKind
     from replication.runner.config import expand
     from replication.runner.execute import execute
     from replication.runner.store import Store
@@ -273,10 +273,10 @@ def test_3123_runs_record_target_3s_marginal_and_a_rating(make_cfg, tmp_path):
     experiment = OmegaConf.to_container(cfg.experiment, resolve=True)
     with pytest.warns(UserWarning, match="published values not found"):  # a missing file is not fatal
         published = load_published(str(tmp_path / "absent.csv"))
-    spec = {"name": "t3", "paper_table": "3", "metric": "failed", "paper_metric": "stability"}
-    table = Rating(spec, experiment, published).build(records).frame
+    spec = {"name": "t3", "kind": "rating", "paper_table": "3", "metric": "failed", "paper_metric": "stability"}
+    table = TableKind.of(spec, experiment, published).build(records).frame
     assert set(table["rating"]) <= {"good", "medium", "poor"} and len(table) == 2
-    table = Rating({**spec, "metric": "failed[target3]"}, experiment, published).build(records).frame
+    table = TableKind.of({**spec, "metric": "failed[target3]"}, experiment, published).build(records).frame
     assert set(table["rating"]) <= {"good", "medium", "poor"} and len(table) == 2
 
 

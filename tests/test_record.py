@@ -308,7 +308,8 @@ def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically
 def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):
     """Two drawn report folders whose summaries differ in one claim's verdict and one cell's estimate: diff reads
     what the summaries decide (no claims.csv or summary.csv there) and names both."""
-    from replication.evidence.claims import Check, Result, load_papers
+    from replication.evidence.checks import Check, Result
+    from replication.evidence.claims import load_papers
     from replication.evidence.published import load_published, published_path
     from replication.evidence.schema import Summary
     from replication.evidence.statistics import Estimate

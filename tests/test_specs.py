@@ -30,7 +30,7 @@ def test_every_kind_is_in_one_registry_and_every_figure_kind_is_drawn():
     assert {"comparison", "summary", "ranking", "modes"} <= set(TABLE_KINDS)
     assert {"order", "threshold", "uniformity"} <= set(CLAIM_TESTS)
     assert set(DRAWINGS) == set(FIGURE_KINDS.values())  # a kind without its drawing, or a drawing of no kind
-    assert FIGURE_KINDS["per_frame_curve"].curve is not None and FIGURE_KINDS["ranking"].curve is None
+    assert FIGURE_KINDS["per_frame_curve"].curved and not FIGURE_KINDS["ranking"].curved
 
 
 def test_every_shipped_spec_is_typed_and_passes_the_check(tmp_path):

@@ -18,6 +18,7 @@ from replication import atomic
 from replication.condition import PREFIX, label_of
 from replication.errors import ConfigError
 from replication.evidence.aggregate import summarise
+from replication.evidence.figures import figure_spec
 from replication.report.figures.metric import metric_vs_condition
 from replication.report.pages.render import html_table, render
 
@@ -86,7 +87,9 @@ def write_sweep_report(records: pd.DataFrame, key: str, metric: str, experiment:
         figure = f"{stem}.png"
         x = pd.to_numeric(records["swept"]).unique()
         log_x = bool(x.min() > 0 and x.max() >= 10 * x.min())  # counts over decades; a c1 of 0..2 stays linear
-        metric_vs_condition(tagged, {"metric": metric, "x": name, "title": key, "log_x": log_x}, experiment, out / figure)
+        spec = figure_spec({"name": stem, "kind": "metric_vs_condition", "metric": metric, "x": name, "title": key,
+                            "log_x": log_x})
+        metric_vs_condition(tagged, spec, experiment, out / figure)
         sections.append({"title": f"{metric} against {key} (mean, 95% interval over runs)", "figure": figure,
                          "table": None})
     sections.append({"title": f"{metric} by value", "figure": None, "table": html_table(table.round(4))})
