@@ -194,6 +194,7 @@ def run_experiment(cfg: DictConfig) -> None:
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
               + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
         from replication.report.experiments import write_experiment
+        from replication.evidence.scorecard import Scorecard
         from replication.report.pages.index import write_index
         from hydra.core.hydra_config import HydraConfig
 
@@ -201,7 +202,8 @@ def run_experiment(cfg: DictConfig) -> None:
 
         results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
         written = write_experiment(cfg, results)  # judged (evidence), then drawn (report)
-        index = write_index(resolve(cfg.reports), cfg.published_values)  # the same published values as the page
+        # the scorecard with this experiment's new summary, against the same published values as the page
+        index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
         print(f"{cfg.experiment.name}: report in {written}; index in {index}")
         if results.own and cfg.experiment.get("also"):
             print(f"skipped: {', '.join(cfg.experiment.also)}, run beside {cfg.experiment.name} as shipped, since "
@@ -285,11 +287,12 @@ def run_multiverse(cfg: DictConfig) -> None:
                       + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
         from hydra.core.hydra_config import HydraConfig
 
+        from replication.evidence.scorecard import Scorecard
         from replication.report.experiments import write_multiverse
         from replication.report.pages.index import write_index
 
         written = write_multiverse(cfg, multiverse, tuple(HydraConfig.get().overrides.task), reader(recorded, layers))
-        index = write_index(resolve(cfg.reports), cfg.published_values)
+        index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
         print(f"{name}: report in {written}; index in {index}")
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))

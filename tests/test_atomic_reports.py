@@ -29,14 +29,15 @@ def filling(write, name: str):
 
 
 def test_a_full_disk_under_reports_is_one_line_naming_the_folder_and_the_previous_file_stays(tmp_path, monkeypatch):
+    from replication.evidence.scorecard import Scorecard
     from replication.report.pages.index import write_index
 
     reports = tmp_path / "reports"
-    write_index(reports)
+    write_index(reports, Scorecard.read(reports))
     before = {name: (reports / name).read_bytes() for name in ("summary.csv", "claims.csv", "index.html")}
     monkeypatch.setattr(pd.DataFrame, "to_csv", filling(pd.DataFrame.to_csv, "summary.csv"))
     with pytest.raises(DiskFull) as full:
-        write_index(reports)
+        write_index(reports, Scorecard.read(reports))
     message = str(full.value)
     assert "\n" not in message and message.startswith(f"{reports}: no space left on its disk (writing summary.csv)")
     assert {name: (reports / name).read_bytes() for name in before} == before  # whole, as before

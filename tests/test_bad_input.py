@@ -309,10 +309,11 @@ def test_a_users_own_sequences_get_their_own_report_and_leave_the_scorecard_alon
     """``data.otb=<folder> sequences=[...]`` on a copy of a shipped sequence under another name: the
     experiment's methods on it alone, reported as hspf@mine with what differs, no companion run, and
     claims.csv byte-identical before and after."""
+    from replication.evidence.scorecard import Scorecard
     from replication.report.pages.index import write_index
 
     clip = girl_copy(tmp_path).rename(tmp_path / "otb" / "MyClip")
-    before = (write_index(tmp_path / "reports").parent / "claims.csv").read_bytes()
+    before = (write_index(tmp_path / "reports", Scorecard.read(tmp_path / "reports")).parent / "claims.csv").read_bytes()
     result = cli("experiment=hspf", "scale=quick", "experiment.runs.quick=1", f"data.otb={clip.parent}",
                  "sequences=[MyClip]", "label=mine", timeout=900)
     assert result.returncode == 0, result.stderr
@@ -349,11 +350,12 @@ def test_every_shipped_experiment_passes_the_preflight(tmp_path):
 def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_alone(cli, tmp_path):
     """bis_pf_pets with another MOTChallenge sequence in the PETS scene's place: reported as bis_pf_pets@campus,
     the bis_pf.pets and bis_pf.cost rows (and every other) of claims.csv byte-identical."""
+    from replication.evidence.scorecard import Scorecard
     from replication.report.pages.index import write_index
 
     if not (PROJECT_ROOT / "../shared/data/mot/TUD-Campus").is_dir():
         pytest.skip("MOT data not beside the project")
-    before = (write_index(tmp_path / "reports").parent / "claims.csv").read_bytes()
+    before = (write_index(tmp_path / "reports", Scorecard.read(tmp_path / "reports")).parent / "claims.csv").read_bytes()
     result = cli("experiment=bis_pf_pets", "scale=quick", "experiment.runs.quick=1",
                  "experiment.scenes.exp6_pets09.name=TUD-Campus", "experiment.scenes.exp6_pets09.last=20",
                  "label=campus", timeout=900)

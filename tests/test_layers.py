@@ -99,6 +99,8 @@ def test_one_report_judges_against_one_published_values_file(tmp_path):
     """The index and the figures take the file the report was given; nothing reloads the default."""
     import pandas as pd
 
+    from replication.evidence.scorecard import Scorecard
+
     from replication.report.pages.index import write_index
 
     for figure in (PACKAGE_DIR / "report" / "figures").glob("*.py"):
@@ -106,7 +108,7 @@ def test_one_report_judges_against_one_published_values_file(tmp_path):
     own = tmp_path / "mine.csv"
     own.write_text("paper,table,experiment,method,metric,condition,value,unit,note\n"
                    "gps_qmcpf,1,ungm,PF,rmse,N=500,9.99,,a number of my own\n")
-    write_index(tmp_path / "reports", own)
+    write_index(tmp_path / "reports", Scorecard.read(tmp_path / "reports", own))
     summary = pd.read_csv(tmp_path / "reports" / "summary.csv", keep_default_na=False, dtype=str)
     assert list(summary["paper_value"]) == ["9.99"] and list(summary["note"]) == ["a number of my own"]
 

@@ -264,6 +264,7 @@ def test_the_report_drawn_from_a_record_shows_its_verdicts_beside_this_machines(
     assert status["runs"] == len(runs) and status["experiments"]["hspf_ungm"]["runs"] == len(runs)
     assert status["experiments"]["hspf_ungm"]["stale"] == 0 and status["experiments"]["hspf_ungm"]["cpu_minutes"] > 0
     from replication.evidence.claims import load_papers
+    from replication.evidence.scorecard import Scorecard
     from replication.report.pages.index import write_index
     from replication.report.pages.recorded import recorded
 
@@ -271,7 +272,7 @@ def test_the_report_drawn_from_a_record_shows_its_verdicts_beside_this_machines(
     assert shown["runs"] == len(runs) and shown["stale"] == {} and shown["recomputed"] is None
     judged = {claim for claim, row in shown["claims"].items() if row.primary.scale == "paper"}
     assert judged and all(claim.startswith("hspf.") for claim in judged)  # the recorded experiment's claims
-    page = write_index(reports).read_text()
+    page = write_index(reports, Scorecard.read(reports)).read_text()
     assert "paper scale (recorded at " in page and f"{len(runs)} runs of 1 experiments" in page
     assert 'href="record/hspf_ungm/index.html#claims"' in page
 

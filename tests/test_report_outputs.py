@@ -14,6 +14,7 @@ from hydra import compose, initialize_config_dir
 
 from replication.evidence.quantities import quantity
 from replication.paths import CONF_DIR, resolve
+from replication.evidence.scorecard import Scorecard
 from replication.report.pages.index import write_index
 from replication.evidence.published import load_published
 from replication.report.pages.render import ENVIRONMENT, browser, open_in_browser
@@ -109,7 +110,7 @@ def test_index_shows_the_summary_from_the_experiments_summary_json(tmp_path, pub
     Summary("gps_qmcpf", "QMC filters", "qmc", "quick", 4, 4, cells=(
         _cell(published, 0, table_name="table1_rmse", ours=4.0, ci_low=3.5, ci_high=4.5, verdict=REPRODUCED),
     )).write(reports / "quick" / "gps_qmcpf")
-    page = write_index(reports, tmp_path / "published.csv")
+    page = write_index(reports, Scorecard.read(reports, tmp_path / "published.csv"))
     html = page.read_text()
     body = html.split('<table id="cells"', 1)[1].split("</table>", 1)[0]
     assert body.count("<tr") == 1 + len(published)  # header + one row per cell

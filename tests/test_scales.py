@@ -12,6 +12,7 @@ from conftest import PROJECT_ROOT
 from replication.evidence.schema import Summary
 from replication.paths import CONF_DIR
 from replication.report.experiments import write_experiment
+from replication.evidence.scorecard import Scorecard
 from replication.report.pages.index import write_index
 from replication.runner.config import expand
 from replication.runner.execute import execute
@@ -46,7 +47,7 @@ def test_both_scales_pages_stay_and_the_scorecard_names_each_verdicts_scale(make
         assert f'href="{home}"' in page.read_text() and (page.parent / home).resolve() == reports / "index.html"
 
     def scorecard() -> tuple[str, str, str]:
-        index = write_index(reports).read_text()
+        index = write_index(reports, Scorecard.read(reports)).read_text()
         row = index.split('<tr id="hspf.ungm">', 1)[1].split("</tr>", 1)[0]
         return index, row, pd.read_csv(reports / "claims.csv").set_index("claim_id").loc["hspf.ungm", "scale"]
 

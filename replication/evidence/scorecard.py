@@ -16,9 +16,10 @@ import pandas as pd
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
 from replication.evidence.checks import Check
-from replication.evidence.claims import Claim, Paper, Reading
+from replication.evidence.claims import Claim, Paper, Reading, load_papers
+from replication.evidence.published import load_published, published_path
 from replication.evidence.schema import RobustnessResult, Summary
-from replication.evidence.summary import experiment_configs, summary_table
+from replication.evidence.summary import experiment_configs, load_summaries, summary_table
 
 
 @dataclass(frozen=True)
@@ -192,6 +193,7 @@ class Scorecard:
     cells: pd.DataFrame
     tallies: dict[str, str]
     claims: pd.DataFrame
+    papers: tuple[Paper, ...] = ()
 
     @classmethod
     def of(cls, summaries: dict[str, Summary], papers: list[Paper], published: pd.DataFrame) -> "Scorecard":
@@ -200,7 +202,14 @@ class Scorecard:
         rows = claim_rows(papers, summaries)
         cells = summary_table(published, summaries, experiment_configs(), owner_of_cells(papers, published))
         tallies = cell_tallies(cells)
-        return cls(summaries, rows, cells, tallies, claims_frame(rows, cells, tallies))
+        return cls(summaries, rows, cells, tallies, claims_frame(rows, cells, tallies), tuple(papers))
+
+    @classmethod
+    def read(cls, reports, published_values=None) -> "Scorecard":
+        """The scorecard of the reports in folder ``reports`` (each experiment's summary, at the paper scale where
+        there is one), the five papers' claims, judged against the published values ``published_values`` (the
+        shipped file unless named)."""
+        return cls.of(load_summaries(reports), list(load_papers()), load_published(str(published_path(published_values))))
 
     @property
     def cell_table(self) -> pd.DataFrame:

@@ -31,6 +31,7 @@ from replication import atomic
 from replication.arguments import read
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
+from replication.evidence.scorecard import Scorecard
 from replication.evidence.settings import configure
 from replication.paths import CONF_DIR, experiment_names, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
@@ -111,15 +112,15 @@ def main(argv: list[str]) -> None:
     if options.pdf:
         from replication.report.pdf import write_pdf
 
-        print(f"pdf: {write_pdf(reports, cfg.published_values)}")
-    index = write_index(reports, cfg.published_values)
+        print(f"pdf: {write_pdf(reports, Scorecard.read(reports, cfg.published_values))}")
+    index = write_index(reports, Scorecard.read(reports, cfg.published_values))
     templates = resolve(cfg.findings) / "templates"
     if source == "record" and templates.is_dir():  # a clone's docs/findings/templates (none installed)
         try:  # rendered from the summaries the index read, then linked from it
             for page in write_html(render_findings(Drawn(reports, cfg.published_values), templates),
                                    reports / "findings"):
                 print(f"findings: {page}")
-            index = write_index(reports, cfg.published_values)
+            index = write_index(reports, Scorecard.read(reports, cfg.published_values))
         except LookupError as error:
             print(f"findings: not drawn: {error}", file=sys.stderr)
     print(f"index: {index}")

@@ -27,10 +27,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication.errors import fail
-from replication.evidence.claims import load_papers
-from replication.evidence.published import load_published, published_path
 from replication.evidence.scorecard import Scorecard
-from replication.evidence.summary import load_summaries
 from replication.paths import resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest
 from replication.scales import SCALES, report_folder
@@ -94,7 +91,7 @@ def is_drawn(folder: Path) -> bool:
 def decided(folder: Path) -> dict[tuple[str, ...], pd.DataFrame]:
     """What the summaries in a drawn report ``folder`` decide, keyed as compared: the claims (by :data:`CLAIM`)
     and the published cells (by :data:`CELL`), as ``claims.csv`` and ``summary.csv`` export them."""
-    card = Scorecard.of(load_summaries(folder), list(load_papers()), load_published(str(published_path(None))))
+    card = Scorecard.read(folder)
     return {CLAIM: card.claims, CELL: card.cell_table}
 
 

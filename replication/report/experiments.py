@@ -5,6 +5,7 @@ it; what needs video or compiled code reaches both through one
 :class:`~replication.runner.footage.SceneFootage`."""
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
@@ -44,8 +45,10 @@ def write_experiment(cfg: DictConfig, results: Results) -> Path:
                 if "per_frame" in results.records
                 and write_results(results.runs, results.records, out / "results", layout)]
     scenes = footage.described(results.experiment, OmegaConf.to_container(cfg.experiment, resolve=True))
-    return write_experiment_report(cfg, judged, Shown(out, published, footage, files, exported, scenes,
-                                                      results.curves, results.command))
+    drawn = write_experiment_report(cfg, judged, Shown(out, published, footage, files, exported, scenes,
+                                                       results.curves, results.command))
+    replace(judged.summary, figures=drawn.figures).write(out)  # the judgement, with the figures drawn of it
+    return drawn.page
 
 
 def write_multiverse(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[str, ...] = (),
@@ -58,4 +61,6 @@ def write_multiverse(cfg: DictConfig, multiverse: Multiverse, overrides: tuple[s
         multiverse, lambda name, universe: store_of(name, universe).load(multiverse.runs[universe.name, name]),
         title=cfg.experiment.get("title", multiverse.name), scale=cfg.scale,
         published=load_published(str(published_path(cfg.published_values))), footage=SceneFootage())
-    return write_multiverse_report(cfg, multiverse, judged, overrides)
+    drawn = write_multiverse_report(cfg, multiverse, judged, overrides)
+    replace(judged.summary, figures=drawn.figures).write(drawn.page.parent)
+    return drawn.page

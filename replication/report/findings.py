@@ -43,9 +43,7 @@ import pandas as pd
 
 from replication import atomic
 from replication.evidence.claims import Paper, load_papers
-from replication.evidence.published import load_published, published_path
 from replication.evidence.scorecard import Scorecard
-from replication.evidence.summary import load_summaries
 from replication.evidence.tables import Table, cell_value, interval, number
 from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, PROFILE, sha256
@@ -79,8 +77,7 @@ class Drawn:
 
     @cached_property
     def card(self) -> Scorecard:
-        return self.decided or Scorecard.of(load_summaries(self.folder), list(load_papers()),
-                                            load_published(str(published_path(self.published))))
+        return self.decided or Scorecard.read(self.folder, self.published)
 
     @property
     def claims(self) -> pd.DataFrame:

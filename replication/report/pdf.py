@@ -35,12 +35,11 @@ from omegaconf import OmegaConf  # noqa: E402
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
 from replication.report.pages import glance  # noqa: E402
 from replication.report.pages.index import TITLE  # noqa: E402
-from replication.evidence.published import load_published, published_path  # noqa: E402
-from replication.evidence.claims import Paper, load_papers  # noqa: E402
+from replication.evidence.claims import Paper  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
 from replication.evidence.scorecard import Scorecard, tally  # noqa: E402
 from replication.evidence.schema import Summary  # noqa: E402
-from replication.evidence.summary import counts, load_summaries  # noqa: E402
+from replication.evidence.summary import counts  # noqa: E402
 from replication.evidence.tables import Table  # noqa: E402
 from replication.evidence.settings import rules  # noqa: E402
 from replication.scales import report_folder  # noqa: E402
@@ -58,12 +57,11 @@ SUMMARY_COLUMNS = {  # the summary's columns as printed: heading -> how wide it 
 SCORECARD_COLUMNS = {"claim": 60, "verdict": 15, "deciding number (its interval)": 30, "why": 60, "readings": 40}
 
 
-def write_pdf(reports: Path, published_values: str | Path | None = None) -> Path:
-    """Write ``reports/replication.pdf`` from what ``reports/`` holds; return its path."""
+def write_pdf(reports: Path, card: Scorecard) -> Path:
+    """Write ``reports/replication.pdf`` from what ``reports/`` holds and ``card``, the scorecard its caller read
+    from the reports' summaries (:meth:`~replication.evidence.scorecard.Scorecard.read`); return its path."""
     reports = Path(reports)
-    summaries = load_summaries(reports)
-    papers = load_papers()
-    card = Scorecard.of(summaries, papers, load_published(str(published_path(published_values))))
+    summaries, papers = card.summaries, list(card.papers)
     path = reports / "replication.pdf"
     reports.mkdir(parents=True, exist_ok=True)
     quick = [name for name, s in summaries.items() if s.scale != "paper"]
@@ -411,9 +409,9 @@ def main(argv: list[str]) -> None:
     from replication.report.pages.index import write_index
 
     reports = resolve(options.reports or OmegaConf.load(CONF_DIR / "config.yaml").reports)
-    path = write_pdf(reports, options.published_values)
+    path = write_pdf(reports, Scorecard.read(reports, options.published_values))
     print(f"pdf: {path}")
-    print(f"index: {write_index(reports, options.published_values)}")
+    print(f"index: {write_index(reports, Scorecard.read(reports, options.published_values))}")
 
 
 if __name__ == "__main__":

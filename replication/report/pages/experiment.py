@@ -1,11 +1,12 @@
 """One experiment's page, drawn from its judgement (:func:`replication.evidence.judge.judge_experiment`): its
-tables as CSV and HTML, its figures, a page tying them together and ``summary.json``; the files the caller
-wrote beside it (every run and frame as tidy tables, the toolkits' results) linked.  Nothing is decided here."""
+tables as CSV and HTML, its figures and a page tying them together; the files the caller wrote beside it (every
+run and frame as tidy tables, the toolkits' results) linked.  Nothing is decided or stored as a decision here:
+the caller writes ``summary.json`` with the figures drawn (:class:`Drawn`)."""
 
 import platform
 import sys
 from collections import Counter
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,10 +49,19 @@ class Shown:
     command: str = ""
 
 
-def write_experiment_report(cfg: DictConfig, judged: Judgement, shown: Shown) -> Path:
-    """Write an experiment's page into ``shown.out`` (``<reports>/<experiment>/``, at the quick scale
-    ``<reports>/quick/<experiment>/``) from its ``judged`` runs: its tables as CSV and HTML, its figures, the page
-    and ``summary.json``; return the page's path."""
+@dataclass(frozen=True)
+class Drawn:
+    """What a page drew: its path and its figures (name, title, file, and link and beside where given), which
+    the caller stores with the judgement's summary."""
+
+    page: Path
+    figures: tuple[dict[str, str], ...] = ()
+
+
+def write_experiment_report(cfg: DictConfig, judged: Judgement, shown: Shown) -> Drawn:
+    """Draw an experiment's page into ``shown.out`` (``<reports>/<experiment>/``, at the quick scale
+    ``<reports>/quick/<experiment>/``) from its ``judged`` runs: its tables as CSV and HTML, its figures and the
+    page; return what it drew (the caller stores the summary: :func:`replication.report.experiments.write_experiment`)."""
     experiment, records, summary, out = judged.experiment, judged.records, judged.summary, shown.out
     tables, figures, left_out = [], [], []
     for written in summary.tables:
@@ -110,8 +120,7 @@ def write_experiment_report(cfg: DictConfig, judged: Judgement, shown: Shown) ->
             versions=_versions(),
         )
     )
-    replace(summary, figures=tuple(figures)).write(out)
-    return page
+    return Drawn(page, tuple(figures))
 
 
 def _claims_shown(claims: dict[str, dict[str, Result]]) -> list[dict]:

@@ -16,8 +16,6 @@ from pathlib import Path
 import replication
 from replication import atomic
 from replication.paths import experiment_names
-from replication.evidence.claims import load_papers
-from replication.evidence.published import load_published, published_path
 from replication.record.manifest import PAGES
 from replication.report.pages import glance
 from replication.report.pages.recorded import recorded
@@ -63,17 +61,18 @@ def _findings(reports: Path, paper: str) -> str | None:
     return None
 
 
-def write_index(reports: Path, published_values: str | Path | None = None) -> Path:
+def write_index(reports: Path, card: Scorecard) -> Path:
+    """Draw ``reports/index.html`` around ``card``, the scorecard its caller read from the reports' summaries
+    (:meth:`~replication.evidence.scorecard.Scorecard.read`), and write its exports (``summary.csv``,
+    ``claims.csv``); return the page's path."""
     reports = Path(reports)
-    summaries = load_summaries(reports)  # what the scorecard reads: each experiment's at one scale
+    summaries, papers = card.summaries, list(card.papers)  # each experiment's summary at one scale
     missing = [name for name in experiment_names() if name not in summaries]
     pages = {scale: load_summaries(reports, scales=(scale,)) for scale in SCALES}  # every page, at both scales
     experiments = [_entry(name, pages[scale][name]) for name in experiment_names() for scale in SCALES
                    if name in pages[scale]]
     own = [_entry(name, summary) for scale in SCALES
            for name, summary in load_summaries(reports, own=True, scales=(scale,)).items()]
-    papers = load_papers()
-    card = Scorecard.of(summaries, papers, load_published(str(published_path(published_values))))
     rows, cells, tallies = card.rows, card.cells, card.tallies
     record = recorded(reports, papers)
     reports.mkdir(parents=True, exist_ok=True)

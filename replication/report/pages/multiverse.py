@@ -11,7 +11,6 @@ with its interval and the best case for the paper: the case that comes
 closest to the claim holding, with its number.
 """
 
-from dataclasses import replace
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -25,6 +24,7 @@ from replication.evidence.multiverse import READING, Robustness
 from replication.evidence.settings import rules
 from replication.evidence.statistics import said_level
 from replication.paths import resolve
+from replication.report.pages.experiment import Drawn
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.scales import index_from, report_folder
@@ -78,10 +78,11 @@ def _headline(robustness: Robustness) -> str | None:
 
 
 def write_multiverse_report(cfg: DictConfig, multiverse: Universes, judged: MultiverseJudgement,
-                            overrides: tuple[str, ...] = ()) -> Path:
+                            overrides: tuple[str, ...] = ()) -> Drawn:
     """``<reports>/<paper>_readings/`` (at the quick scale under ``<reports>/quick/``), drawn from the multiverse's
     judgement (:func:`replication.evidence.judge.judge_multiverse`): the choices, the universes run, each claim's
-    robustness with every case, the forest plot, and ``summary.json`` (under ``multiverse``) for the scorecard."""
+    robustness with every case and the forest plot; return what it drew (the caller stores the summary, whose
+    ``multiverse`` the scorecard reads)."""
     out = report_folder(resolve(cfg.reports), multiverse.name, cfg.scale)
     out.mkdir(parents=True, exist_ok=True)
     robustness = judged.robustness
@@ -100,5 +101,4 @@ def write_multiverse_report(cfg: DictConfig, multiverse: Universes, judged: Mult
                           *(o for o in overrides if not o.startswith(("experiment=", "scale=")))])))
     figures = ({"name": "readings", "file": "readings.png",
                 "title": "Each claim's deciding number in every universe (its test's interval, coloured by verdict)"},)
-    replace(judged.summary, figures=figures if (out / "readings.png").exists() else ()).write(out)
-    return page
+    return Drawn(page, figures if (out / "readings.png").exists() else ())
