@@ -54,6 +54,17 @@ class Spec:
         return cls(**values)
 
 
+def kind_named(written: Any, kinds, name: Any, where: str, what: str):
+    """The kind ``name`` stands for in registry ``kinds``, for a spec ``written`` that must be a mapping of
+    options (``what``: how the error names it, "a figure"); refused in one line said from ``where``."""
+    if not isinstance(written, Mapping):
+        raise ConfigError(f"{where}: {what} is a mapping of options, got {written!r}")
+    try:
+        return kinds[name]
+    except ConfigError as error:
+        raise ConfigError(f"{where}: {error}") from None
+
+
 def _members(wanted: Any) -> tuple:
     return typing.get_args(wanted) if typing.get_origin(wanted) in (typing.Union, types.UnionType) else (wanted,)
 

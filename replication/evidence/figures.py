@@ -13,9 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
-from replication.errors import ConfigError
 from replication.kinds import Registry
-from replication.specs import Spec
+from replication.specs import Spec, kind_named
 
 FIGURE_KINDS: Registry[type["FigureSpec"]] = Registry("figure kind")
 
@@ -64,12 +63,8 @@ def figure_spec(written: Mapping | FigureSpec, where: str = "") -> FigureSpec:
         return written
     name = written.get("name") if isinstance(written, Mapping) else None
     where = f"{where}: figure {name!r}" if where else f"figure {name!r}"
-    if not isinstance(written, Mapping):
-        raise ConfigError(f"{where}: a figure is a mapping of options, got {written!r}")
-    try:
-        made = FIGURE_KINDS[written.get("kind")]
-    except ConfigError as error:
-        raise ConfigError(f"{where}: {error}") from None
+    made = kind_named(written, FIGURE_KINDS, written.get("kind") if isinstance(written, Mapping) else None, where,
+                      "a figure")
     return made.of(written, f"{where} ({written['kind']})")
 
 

@@ -7,12 +7,11 @@ from typing import Any, ClassVar
 
 import pandas as pd
 
-from replication.errors import ConfigError
 from replication.evidence.checks import Check
 from replication.evidence.named_conditions import as_mappings, matching
 from replication.evidence.tables import Table
 from replication.kinds import Registry
-from replication.specs import Spec
+from replication.specs import Spec, kind_named
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -49,12 +48,8 @@ def claim_spec(written: Mapping | ClaimSpec, where: str = "a claim's reading") -
     """A reading's test as its kind declares it (``test:``), checked (:meth:`~replication.specs.Spec.of`)."""
     if isinstance(written, ClaimSpec):
         return written
-    if not isinstance(written, Mapping):
-        raise ConfigError(f"{where}: a reading is a mapping of options, got {written!r}")
-    try:
-        made = CLAIM_TESTS[written.get("test")]
-    except ConfigError as error:
-        raise ConfigError(f"{where}: {error}") from None
+    made = kind_named(written, CLAIM_TESTS, written.get("test") if isinstance(written, Mapping) else None, where,
+                      "a reading")
     return made.Spec.of({k: v for k, v in written.items() if k not in READING_KEYS}, f"{where} ({made.name})",
                         READING_KEYS)
 

@@ -27,7 +27,7 @@ from replication.evidence.published import cells
 from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import Outcome, Verdict
 from replication.kinds import Registry
-from replication.specs import Spec
+from replication.specs import Spec, kind_named
 
 # the equivalence tolerance is our choice (the papers state none): each compared cell is also judged at
 # these, so the index shows how far the cells' verdicts move with it
@@ -274,13 +274,9 @@ def table_spec(written: Mapping | TableSpec, where: str = "") -> TableSpec:
         return written
     name = written.get("name") if isinstance(written, Mapping) else None
     where = f"{where}: table {name!r}" if where else f"table {name!r}"
-    if not isinstance(written, Mapping):
-        raise ConfigError(f"{where}: a table is a mapping of options, got {written!r}")
-    kind = written.get("kind") or ("summary" if "metrics" in written else "comparison")
-    try:
-        made = TABLE_KINDS[kind]
-    except ConfigError as error:
-        raise ConfigError(f"{where}: {error}") from None
+    kind = (written.get("kind") or ("summary" if "metrics" in written else "comparison")
+            if isinstance(written, Mapping) else None)
+    made = kind_named(written, TABLE_KINDS, kind, where, "a table")
     return made.Spec.of({**written, "kind": kind}, f"{where} ({kind})")
 
 
