@@ -2,6 +2,8 @@
 
 import time
 
+import numpy as np
+
 from replication.record.manifest import _load, _summed
 from replication.stopwatch import Stopwatch, load_1m
 
@@ -59,3 +61,21 @@ def test_the_reference_work_is_timed_once_per_interval_and_again_after_it(monkey
     assert every() == 1.0
     clock[0] += 0.1
     assert every() == 2.0 and measured == [100.0, 160.0]
+
+
+def test_a_reading_on_a_column_its_runs_never_recorded_is_not_testable_and_says_why():
+    """The record's runs predate the CPU clock: the CPU-time reading of hspf.cost is not testable on them, and
+    says which column is missing, while the wall-clock reading beside it is tested."""
+    import pandas as pd
+
+    from replication.evidence.claims import evaluate
+    from replication.evidence.verdict import Outcome
+
+    noise = np.random.default_rng(4).normal(0.0, 0.02, (10, 2))
+    rows = [{"method": m, "condition": "", "data_condition": "", "repetition": r, "ms_per_step": t + noise[r, i]}
+            for r in range(10) for i, (m, t) in enumerate((("HSPF", 1.2), ("PF", 1.0)))]
+    results = evaluate("hspf_ungm", {"name": "hspf_ungm", "paper": "hspf"}, pd.DataFrame(rows), {})["hspf.cost"]
+    cpu = next(result for name, result in results.items() if name.endswith("on thread CPU time"))
+    assert cpu.verdict.outcome is Outcome.NOT_TESTABLE and "no run recorded cpu_ms_per_step" in cpu.verdict.why
+    wall = results["HSPF no more than 50 % slower than PF per step, paired by run (this machine)"]
+    assert wall.verdict.outcome is not Outcome.NOT_TESTABLE

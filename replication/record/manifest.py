@@ -166,22 +166,27 @@ def _read_machines(data: list[dict] | None) -> tuple[Machine, ...] | None:
     return None if data is None else tuple(Machine.of(d) for d in data)
 
 
+def _present(rows: list[dict], key: str) -> list:
+    """The values of ``key`` in the rows that have one."""
+    return [r[key] for r in rows if r.get(key) is not None]
+
+
 def _summed(rows, key: str) -> float | None:
     """The sum of ``key`` over ``rows`` (None where no row has it)."""
-    values = [r[key] for r in rows if r.get(key) is not None]
+    values = _present(rows, key)
     return round(sum(values), 1) if values else None
 
 
 def _median(rows: list[dict], key: str) -> float | None:
     """The median of ``key`` over the rows that have it (None where none does)."""
-    values = sorted(r[key] for r in rows if r.get(key) is not None)
+    values = sorted(_present(rows, key))
     return values[len(values) // 2] if values else None
 
 
 def _load(rows: list[dict]) -> tuple[float, float] | None:
     """The median and maximum of the rows' ``load_1m`` (None where no row has it)."""
-    values = sorted(r["load_1m"] for r in rows if r.get("load_1m") is not None)
-    return (values[len(values) // 2], values[-1]) if values else None
+    median = _median(rows, "load_1m")
+    return None if median is None else (median, max(_present(rows, "load_1m")))
 
 
 def _distinct(rows: list[dict], key: str) -> tuple:

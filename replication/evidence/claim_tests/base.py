@@ -40,6 +40,17 @@ class ClaimSpec(Spec):
         return ""
 
 
+@dataclass(frozen=True, kw_only=True)
+class Measured(ClaimSpec):
+    """A test of one run ``metric`` (the spec of every test that reads one)."""
+
+    metric: str
+
+    @property
+    def reads(self) -> tuple[str, ...]:
+        return (self.metric,)
+
+
 CLAIM_TESTS: Registry[type["ClaimTest"]] = Registry("claim test")
 READING_KEYS = ("name", "experiment", "ours")  # a reading's own keys, beside its test's options
 

@@ -19,7 +19,7 @@ from replication.evidence.settings import INFERENCE
 from replication.evidence.statistics import Estimate
 from replication.evidence.tables import match, pair, table_specs
 from replication.evidence.verdict import Outcome, Verdict, too_few
-from replication.evidence.claim_tests.base import ClaimSpec, ClaimTest, listed
+from replication.evidence.claim_tests.base import ClaimTest, Measured, listed
 
 
 WORK = "evaluations_per_step"  # the work counted beside a time (replication.smc.work)
@@ -41,17 +41,12 @@ class Order(ClaimTest):
     name = "order"
 
     @dataclass(frozen=True, kw_only=True)
-    class Spec(ClaimSpec):
-        metric: str
+    class Spec(Measured):
         order: list
         scale: float = 1.0
         unit: str = ""
         tolerance: float = 0.0
         size: dict[str, Any] | None = None
-
-        @property
-        def reads(self) -> tuple[str, ...]:
-            return (self.metric,)
 
     def checks(self, records, tables):
         metric, scale = self.spec.metric, self.spec.scale
@@ -125,8 +120,7 @@ class EqualCost(ClaimTest):
     name = "equal_cost"
 
     @dataclass(frozen=True, kw_only=True)
-    class Spec(ClaimSpec):
-        metric: str
+    class Spec(Measured):
         cost: str
         method: str | list[str]
         baseline: str | list[str]

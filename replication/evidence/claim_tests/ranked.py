@@ -12,7 +12,7 @@ from replication.evidence.ranking import rankings, unreliable
 from replication.evidence.settings import INFERENCE
 from replication.evidence.statistics import Estimate
 from replication.evidence.verdict import Outcome, Verdict
-from replication.evidence.claim_tests.base import ClaimSpec, ClaimTest
+from replication.evidence.claim_tests.base import ClaimTest, Measured
 from replication.evidence.claim_tests.threshold import threshold_verdict
 
 
@@ -28,12 +28,11 @@ class Best(ClaimTest):
     name = "best"
 
     @dataclass(frozen=True, kw_only=True)
-    class Spec(ClaimSpec):
+    class Spec(Measured):
         """A method's ranking (:func:`_ranking`): among ``among`` (every method), over the ``sequences``
         (values of ``over``; every one), in the ranking of ``group`` (a value of ``by``)."""
 
         method: str
-        metric: str
         among: list[str] | None = None
         sequences: list[str] | None = None
         over: str = "scene"

@@ -15,7 +15,7 @@ from replication.evidence.settings import INFERENCE
 from replication.evidence.statistics import Estimate
 from replication.evidence.trends import dominance, log_log_slope
 from replication.evidence.verdict import Outcome, Verdict, too_few
-from replication.evidence.claim_tests.base import ClaimSpec, ClaimTest
+from replication.evidence.claim_tests.base import ClaimSpec, ClaimTest, Measured
 
 
 class Threshold(ClaimTest):
@@ -27,19 +27,14 @@ class Threshold(ClaimTest):
     name = "threshold"
 
     @dataclass(frozen=True, kw_only=True)
-    class Spec(ClaimSpec):
+    class Spec(Measured):
         method: str
-        metric: str
         at_least: float | None = None
         at_most: float | None = None
         condition: Any = None
         statistic: str = "mean"
         machine: str = ""  # "this": a time measured on this machine is tested
         unit: str = ""
-
-        @property
-        def reads(self) -> tuple[str, ...]:
-            return (self.metric,)
 
         @property
         def naming(self) -> tuple:
@@ -111,15 +106,10 @@ class Growth(ClaimTest):
     name = "growth"
 
     @dataclass(frozen=True, kw_only=True)
-    class Spec(ClaimSpec):
+    class Spec(Measured):
         method: str
-        metric: str
         x: str
         at_most: float
-
-        @property
-        def reads(self) -> tuple[str, ...]:
-            return (self.metric,)
 
     def checks(self, records, tables):
         spec = self.spec
@@ -151,6 +141,10 @@ class Pareto(ClaimTest):
         method: str
         metrics: list[str]
         chosen: Any = None
+
+        @property
+        def reads(self) -> tuple[str, ...]:
+            return tuple(self.metrics)
 
         @property
         def naming(self) -> tuple:
