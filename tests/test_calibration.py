@@ -6,6 +6,7 @@ import pytest
 import yaml
 
 from replication.evidence import calibration
+from replication.evidence.criteria import SCEPTICAL_LEVEL
 from replication.evidence.settings import INFERENCE
 from replication.paths import CONF_DIR, PACKAGE_DIR
 from replication.report.calibration import CSV, NOTE, evidence_digest, read, write_calibration
@@ -44,7 +45,7 @@ def test_the_papers_size_is_tested_as_a_mean_of_its_runs(quick):
     """The paper's numbers drawn as means of 10, 20, 100 runs and of as many as ours: the size test holds 5 %
     (the level test above covers these rows), detects ours at half the paper's size more often the more runs
     stand behind the paper's, and the rule before, the paper's number taken as exact, errs far more often."""
-    sized = quick[quick["paper_runs"].notna() & (quick["checks"] == 1) & ~quick["control"]]
+    sized = quick[quick["paper_runs"].notna() & (quick["checks"] == 1) & ~quick["control"] & ~quick["criterion"]]
     # our 5 runs against 5, 10, 20, 100 of the paper's, our 20 against 10, 20, 100: a difference and a ratio
     # under 3 noises and 2 designs of yes/no outcomes each
     assert set(sized["paper_runs"]) == {5, 10, 20, 100} and len(sized[sized["truth"] == "null"]) == (4 + 3) * 8
@@ -54,6 +55,26 @@ def test_the_papers_size_is_tested_as_a_mean_of_its_runs(quick):
     exact = quick[quick["test"].str.contains("taken as exact") & (quick["runs"] == 20)]
     assert len(exact) == 3 and (exact["rate"] > INFERENCE.alpha + 2 * exact["mc_se"]).all()
     assert (exact["rate"] > 0.1).all()
+
+
+def test_the_replication_criteria_are_simulated_under_both_truths_at_every_count(quick):
+    """The golden sceptical p-value and the prediction interval (replication/evidence/criteria.py), through
+    order_test and the criteria's code: the prediction interval holds the replication about 95 % of the time
+    when the paper's effect is true (its coverage), and the golden level rarely calls pure noise replicated;
+    neither row is held to 5 % (holds is empty), and none counts as a rule failing its level."""
+    rows = quick[quick["criterion"]]
+    keys = [calibration.CRITERION[k].name for k in calibration.CALIBRATED_CRITERIA]
+    assert set(rows["test"]) == set(keys) and rows["holds"].isna().all()
+    for runs in (5, 20):  # each of our counts against 10, 20, 100 runs of the paper's and as many as ours
+        assert set(rows.loc[rows["runs"] == runs, "paper_runs"]) == {*calibration.PAPER_RUNS, runs}
+    assert len(rows) == 2 * 2 * 3 * (4 + 3)  # criteria x truths x noises x (paper counts at 5 and at 20 runs)
+    prediction = rows[(rows["test"] == keys[1]) & (rows["truth"] == "effect")]
+    assert (abs(prediction["rate"] - 0.95) < 0.05).all(), prediction[["runs", "paper_runs", "rate"]]
+    sceptical = rows[rows["test"] == keys[0]]
+    assert (sceptical.loc[sceptical["truth"] == "null", "rate"] < SCEPTICAL_LEVEL).all()
+    assert sceptical.loc[(sceptical["truth"] == "effect") & (sceptical["runs"] == 20)
+                         & (sceptical["paper_runs"] == 100), "rate"].min() > 0.5
+    assert failures(rows, 0.0).empty  # shown beside the rules, never failing as one
 
 
 def test_a_rule_that_never_decides_would_fail_the_power_rows(quick):

@@ -49,6 +49,7 @@ import pandas as pd
 from scipy import stats
 
 from replication.evidence.comparisons import Effect, best_test, order_test
+from replication.evidence.criteria import CRITERION
 from replication.evidence.original import PaperRuns
 from replication.evidence.inference import holm, mean_test, sign_test
 from replication.evidence.ranking import rank, rank_set
@@ -72,7 +73,9 @@ CHAINS = (6, 9)  # checks in a reading: ism_pf.accuracy (2 pairs x 3 scenes), gp
 EFFECTS = (0.5, 1.0)
 PAPER_RUNS = (10, 20, 100)  # the papers' counts behind a size: bis_pf; fusion_pf's fewest, the helicopter; ism_pf
 COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "paper_runs", "rate", "mc_se",
-           "wrong_rate", "power", "holds", "control", "replications"]
+           "wrong_rate", "power", "holds", "control", "criterion", "replications"]
+CALIBRATED_CRITERIA = ("sceptical", "prediction")  # the replication criteria simulated (criteria.py): issue 60
+SUCCESS = "replication success"  # what a criterion's row counts
 REPRODUCED, NOT_REPRODUCED = OUTCOMES.index(Outcome.REPRODUCED), OUTCOMES.index(Outcome.NOT_REPRODUCED)
 
 
@@ -102,6 +105,7 @@ class Case:
     draw: Callable[[np.random.Generator, int], np.ndarray]
     control: bool = False
     paper_runs: float = math.nan  # the runs behind each of the paper's simulated numbers (a size's rows)
+    criterion: bool = False  # a replication criterion's success rate: shown, not a verdict rule held to 5 %
 
 
 def _pairs(rng, reps: int, runs: int, distribution: str, gains) -> tuple[np.ndarray, np.ndarray]:
@@ -408,6 +412,7 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
         found += [mcnemar_case(n, "null", "reproduced", 0.2, 0.2), mcnemar_case(n, "null", "not reproduced", 0.2, 0.2),
                   mcnemar_case(n, "effect", "reproduced", 0.5, 0.0)]
         found += size_cases(n, distributions)
+        found += criterion_cases(n, distributions)
         found += [rate_case(n, "null", "reproduced", 0.72), rate_case(n, "null", "reproduced", 0.88),
                   rate_case(n, "null", "not reproduced", 0.8), rate_case(n, "effect", "reproduced", 0.8)]
     for n in (5, 10):
@@ -426,6 +431,36 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
         found += [pareto_case(d, "null", "reproduced", (0.0, 0.0)), pareto_case(d, "null", "not reproduced", (0.0, 1.0)),
                   pareto_case(d, "effect", "reproduced", (-1.0, -1.0))]
     return found
+
+
+def criterion_case(runs, distribution, truth, key, paper_runs) -> Case:
+    """How often replication criterion ``key`` (:data:`~replication.evidence.criteria.CRITERION`) says the
+    replication succeeded, through :func:`~replication.evidence.comparisons.order_test` and the criterion's
+    own function: ``truth = "effect"``: the paper's effect true in its runs and ours, 1 standard deviation of a
+    run's difference; ``"null"``: no effect in either, the paper's two numbers means of ``paper_runs`` runs
+    around one value (where they do not favour the claim it quotes no size, and nothing succeeds)."""
+    gain = 1.0 if truth == "effect" else 0.0
+
+    def draw(rng, reps):
+        better, worse = _pairs(rng, reps, runs, distribution, [gain])
+        theirs = _paper_means(rng, (2, reps, 1), paper_runs, distribution)
+        paper = Effect(theirs[0] + gain * math.sqrt(2.0), theirs[1], _told(paper_runs, False))
+        tested = order_test(better, worse, lower_is_better=False, paper=paper)
+        success = np.zeros((reps, 1), dtype=bool)
+        if tested.replication is not None:
+            favours = paper.gain(lower_is_better=False) > 0
+            success = favours & ~tested.tied & CRITERION[key].met(tested.replication)
+        return np.where(success[:, 0], REPRODUCED, NOT_REPRODUCED)
+
+    return Case(CRITERION[key].name, runs, 1, distribution, truth, SUCCESS, gain, draw, paper_runs=paper_runs,
+                criterion=True)
+
+
+def criterion_cases(runs: int, distributions=DISTRIBUTIONS) -> list[Case]:
+    """The rows of each of :data:`CALIBRATED_CRITERIA` at our ``runs``, the paper's numbers means of each count
+    of :data:`PAPER_RUNS` and of as many runs as ours, under no effect and the paper's effect true."""
+    return [criterion_case(runs, d, truth, key, m) for key in CALIBRATED_CRITERIA for m in sorted({*PAPER_RUNS, runs})
+            for d in distributions for truth in ("null", "effect")]
 
 
 def size_cases(runs: int, distributions=DISTRIBUTIONS) -> list[Case]:
@@ -456,7 +491,7 @@ def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
                 + ((case.paper_runs,) if math.isfinite(case.paper_runs) else ()))
     rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
     codes = case.draw(rng, replications)
-    guarded = REPRODUCED if case.guards in ("reproduced", "robust") else NOT_REPRODUCED  # or "depends", "misses"
+    guarded = REPRODUCED if case.guards in ("reproduced", "robust", SUCCESS) else NOT_REPRODUCED  # or "depends"
     rate = float(np.mean(codes == guarded))
     mc_se = math.sqrt(max(rate * (1 - rate), 1e-12) / replications)
     null = case.truth == "null"
@@ -465,8 +500,9 @@ def simulate(case: Case, replications: int, seed: int = SEED) -> dict:
             "rate": rate, "mc_se": mc_se,
             "wrong_rate": rate if null else float(np.mean(codes == (NOT_REPRODUCED if guarded == REPRODUCED
                                                                      else REPRODUCED))),
-            "power": math.nan if null else rate, "holds": (rate <= INFERENCE.alpha + 2 * mc_se) if null else None,
-            "control": case.control, "replications": replications}
+            "power": math.nan if null else rate,
+            "holds": (rate <= INFERENCE.alpha + 2 * mc_se) if null and not case.criterion else None,
+            "control": case.control, "criterion": case.criterion, "replications": replications}
 
 
 def calibrate(replications: int = REPLICATIONS, runs=RUNS, distributions=DISTRIBUTIONS, progress=None) -> pd.DataFrame:

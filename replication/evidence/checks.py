@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from replication.evidence.criteria import Replication
 from replication.evidence.inference import said_p
 from replication.evidence.statistics import Estimate, said_level
 from replication.evidence.verdict import OUTCOMES, Outcome, Verdict, decide
@@ -28,6 +29,7 @@ class Check:
     # better - worse in the units shown, a cell's published value, a threshold's bound): ours / paper's is the
     # scorecard's common scale (1: as the paper says, 0: no effect)
     timed: bool = False  # the number rests on times measured as the runs ran (machine- and load-dependent)
+    replication: Replication | None = None  # the paper's effect and ours, where it quotes a size (criteria.py)
 
     @property
     def shown(self) -> str:

@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from replication.evidence.criteria import Replication
 from replication.evidence.inference import (
     Test,
     detectable,
@@ -71,6 +72,7 @@ class OrderTest:
     spread: np.ndarray  # the standard deviation of the per-run gain
     tied: np.ndarray  # every run of both methods gives one value: nothing is tested
     bound: Test  # whose upper bound the gain's interval shows: the size test's where in the gain's units
+    replication: Replication | None = None  # the paper's effect and ours on one scale, where it quotes a size
 
     @property
     def p_for(self) -> np.ndarray:
@@ -106,8 +108,9 @@ def order_test(better, worse, lower_is_better: bool, binary: bool = False, allow
         size = replace(found, **{k: np.where(sized, getattr(found, k), getattr(direction, k))
                                  for k in ("p_above", "p_below", "high")})
         bound = direction if paper.kind == "ratio" else size
+        replication = effects(gain, better, worse, lower_is_better, binary, paper, direction.p_above)
     spread = gain.std(axis=-1, ddof=1) if gain.shape[-1] > 1 else np.full(gain.shape[:-1], np.nan)
-    return OrderTest(direction, size, spread, tied, bound)
+    return OrderTest(direction, size, spread, tied, bound, replication if np.any(favours) else None)
 
 
 def size_test(gain, better, worse, lower_is_better: bool, binary: bool, paper: Effect) -> Test:
@@ -160,6 +163,43 @@ def size_test(gain, better, worse, lower_is_better: bool, binary: bool, paper: E
     found = t_test(estimate, np.sqrt(variance), n - 1, n, reference,
                    f"{form} with the paper's own noise ({paper.runs})", INFERENCE.size_alpha)
     return replace(found, p_below=np.minimum(1.0, found.p_below * (INFERENCE.alpha / INFERENCE.size_alpha)))
+
+
+def effects(gain, better, worse, lower_is_better: bool, binary: bool, paper: Effect, p_direction) -> Replication:
+    """The paper's effect and ours on one scale, oriented so that positive favours the claim, each with its
+    standard error (the paper's from our per-run spread at its run count, as :func:`size_test` takes it, but
+    unrestricted by a null), for the criteria of :mod:`replication.evidence.criteria`:
+
+    * a difference: our mean gain, se sqrt(var(gain) / n); the paper's gap, se sqrt((var(better) +
+      var(worse)) / n_paper); the per-run spread sd(gain);
+    * a ratio: log(better / worse) of the means (negated where lower is better), ours by the delta method on
+      the paired runs, var(better / mean(better) - worse / mean(worse)) / n, the paper's (cv(better)^2 +
+      cv(worse)^2) / n_paper; the spread that of the per-run term;
+    * yes/no outcomes: the difference of rates, ours paired, (s - d^2) / n with s the discordant share; the
+      paper's two independent binomial rates, (a (1 - a) + b (1 - b)) / n_paper."""
+    n, n_paper = gain.shape[-1], paper.runs.n
+    with np.errstate(all="ignore"):  # one run, or no spread: NaN, and no criterion is met
+        if binary:
+            ours = gain.mean(axis=-1)
+            ours_var = (np.abs(gain).mean(axis=-1) - ours ** 2) / n
+            a, b = np.asarray(paper.better), np.asarray(paper.worse)
+            theirs, theirs_var = paper.gain(lower_is_better), (a * (1 - a) + b * (1 - b)) / n_paper
+            spread, scale = gain.std(axis=-1, ddof=1), "difference of rates"
+        elif paper.kind == "ratio":
+            sign = -1.0 if lower_is_better else 1.0
+            mean_b, mean_w = better.mean(axis=-1), worse.mean(axis=-1)
+            term = better / mean_b[..., None] - worse / mean_w[..., None]
+            ours, ours_var = sign * np.log(mean_b / mean_w), term.var(axis=-1, ddof=1) / n
+            cv2 = better.var(axis=-1, ddof=1) / mean_b ** 2 + worse.var(axis=-1, ddof=1) / mean_w ** 2
+            theirs, theirs_var = sign * np.log(paper.ratio), cv2 / n_paper
+            spread, scale = term.std(axis=-1, ddof=1), "log ratio"
+        else:
+            ours, ours_var = gain.mean(axis=-1), gain.var(axis=-1, ddof=1) / n
+            theirs = paper.gain(lower_is_better)
+            theirs_var = (better.var(axis=-1, ddof=1) + worse.var(axis=-1, ddof=1)) / n_paper
+            spread, scale = gain.std(axis=-1, ddof=1), "difference"
+    return Replication(scale, theirs, np.sqrt(theirs_var), ours, np.sqrt(ours_var), p_direction, n, n_paper,
+                       paper.runs.stated, spread)
 
 
 def best_test(per_sequence, index: int, lower_is_better: bool) -> OrderTest:

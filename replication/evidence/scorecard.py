@@ -16,6 +16,8 @@ import pandas as pd
 from replication.evidence.robustness import DECISIVE
 from replication.evidence.verdict import BAYES_FLOOR, Outcome, Verdict
 from replication.evidence.checks import Check
+from replication.evidence.criteria import CRITERIA, Assessed, assess, relative_effect, sceptical_p, shares, surviving
+from replication.evidence.settings import INFERENCE
 from replication.evidence.claims import Claim, Paper, Reading, load_papers
 from replication.evidence.published import load_published, published_path
 from replication.evidence.schema import RobustnessResult, Summary
@@ -45,6 +47,14 @@ class ClaimRow:
     @property
     def verdict(self) -> Verdict:
         return self.primary.verdict
+
+    @property
+    def assessed(self) -> Assessed:
+        """The claim under the replication literature's criteria (:mod:`replication.evidence.criteria`): its
+        first reading's sized checks, the paper's effect and ours in each."""
+        if self.verdict.outcome is Outcome.NOT_TESTABLE and not self.primary.checks:
+            return Assessed(why_not="not applicable: not testable here")
+        return assess(self.primary.checks, self.primary.reading.test.sized)
 
     @property
     def at_equal_cost(self) -> list[ReadingResult]:
@@ -164,9 +174,38 @@ def claims_frame(rows: dict[str, list[ClaimRow]], cells: pd.DataFrame, tallies: 
                 "robust": row.robust, **_across(row),
                 "scale": row.primary.scale,
                 "cells": int(owned.get(row.claim.id, 0)),
-                "cell_verdicts": tallies.get(row.claim.id, ""), "note": row.claim.note,
+                "cell_verdicts": tallies.get(row.claim.id, ""), "note": row.claim.note, **_criteria(row.assessed),
             })
     return pd.DataFrame(table)
+
+
+def _criteria(assessed: Assessed) -> dict:
+    """The criteria's columns of ``claims.csv``: per criterion how many of the claim's sized effects meet it
+    ("2/3"), the claim's relative effect size, the largest sceptical p-value, how the paper's runs were
+    counted, or why none applies."""
+    n = len(assessed.effects)
+    return {"effects": n, **{f"criterion_{c.key}": f"{assessed.met(c.key)}/{n}" if n else "" for c in CRITERIA},
+            "relative_effect": assessed.relative if n else None,
+            "sceptical_p": max(float(sceptical_p(r)) for r in assessed.effects) if n else None,
+            "paper_runs": assessed.runs_rule, "criteria_not_applicable": assessed.why_not}
+
+
+def effect_points(rows: dict[str, list[ClaimRow]]) -> pd.DataFrame:
+    """Every sized effect of every claim, the paper's and ours standardised by our per-run standard deviation
+    (one unit on both axes), each with its 95 % interval's half-width, and its relative effect size."""
+    points = []
+    for paper, claims in rows.items():
+        for row in claims:
+            for r in row.assessed.effects:
+                d = relative_effect(r)
+                points.append({"paper": paper, "claim_id": row.claim.id, "scale": r.scale,
+                               "original": r.original / r.spread, "replication": r.replication / r.spread,
+                               "original_half": float(r.quantile * r.original_se / r.spread),
+                               "replication_half": float(r.quantile * r.replication_se / r.spread),
+                               "relative_effect": float(d[0]), "relative_low": float(d[1]),
+                               "relative_high": float(d[2])})
+    return pd.DataFrame(points, columns=["paper", "claim_id", "scale", "original", "replication", "original_half",
+                                         "replication_half", "relative_effect", "relative_low", "relative_high"])
 
 
 def _across(row: ClaimRow) -> dict:
@@ -194,6 +233,23 @@ class Scorecard:
     tallies: dict[str, str]
     claims: pd.DataFrame
     papers: tuple[Paper, ...] = ()
+
+    @property
+    def criteria(self) -> list[dict]:
+        """Per paper and over all, the claims meeting each replication criterion of those it applies to."""
+        return shares({paper: [row.assessed for row in claims] for paper, claims in self.rows.items()})
+
+    @property
+    def effects(self) -> pd.DataFrame:
+        """Every sized effect, the paper's against ours (:func:`effect_points`)."""
+        return effect_points(self.rows)
+
+    @property
+    def surviving(self) -> tuple[float, float, float, int]:
+        """The median share of the paper's effect that survives over claims, its 95 % bootstrap interval, and
+        the claims behind it."""
+        return surviving([row.assessed for claims in self.rows.values() for row in claims],
+                         INFERENCE.bootstrap_resamples, INFERENCE.bootstrap_seed)
 
     @classmethod
     def of(cls, summaries: dict[str, Summary], papers: list[Paper], published: pd.DataFrame) -> "Scorecard":

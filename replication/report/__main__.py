@@ -40,6 +40,7 @@ from replication.record.runs import Record
 from replication.report.findings import Drawn, drawn_inputs, inputs, write_html, write_pages
 from replication.report.findings import render as render_findings
 from replication.report.experiments import write_experiment, write_multiverse
+from replication.report.pages.effects import FIGURE as EFFECTS
 from replication.report.pages.index import write_index
 from replication.report.pages.recorded import STATUS, write_status
 from replication.runner.config import expand
@@ -178,7 +179,8 @@ def findings(argv: list[str]) -> None:
     each paper's findings rendered from the record into ``<findings>/<paper>.md``, and the README's part on
     the record between its marks (:mod:`replication.report.findings`), the record's
     pages drawn first (into ``<reports>/record``) unless they were drawn from this very record by this code;
-    when drawn, their first page's picture too (``<findings>/scorecard.png``, where Chromium is installed)."""
+    when drawn, their first page's picture too (``<findings>/scorecard.png``, where Chromium is installed) and
+    the effect picture (``<findings>/effects.png``)."""
     if {"--help", "-h"} & set(argv):
         print(findings.__doc__)
         return
@@ -194,6 +196,9 @@ def findings(argv: list[str]) -> None:
         if (drawn.folder / SCREENSHOT).exists():  # the scorecard's picture, where Chromium is installed
             atomic.save(out / PICTURE, lambda tmp: shutil.copyfile(drawn.folder / SCREENSHOT, tmp))
             print(f"findings: {out / PICTURE}")
+        if (drawn.folder / EFFECTS).exists():  # the effect picture the index drew (none: no sized claim)
+            atomic.save(out / EFFECTS, lambda tmp: shutil.copyfile(drawn.folder / EFFECTS, tmp))
+            print(f"findings: {out / EFFECTS}")
     try:
         pages = render_findings(drawn, out / "templates")
         written = write_pages(pages, out, rendered_from, resolve(settings.get("readme", README_PATH)))

@@ -10,7 +10,8 @@ the package's published values): the claims and cells ``claims.csv`` and ``summa
 files read back.  Each is named as it
 was given, with what is done with it (drawing a record's pages shows a bar of its experiments); the scratch
 folders pages are drawn into are never named, since they are gone when the command ends.  Then one line per
-changed claim (verdict, deciding number and interval, runs) and per changed cell (our estimate, its verdict),
+changed claim (verdict, deciding number and interval, runs, each replication criterion's count of its sized
+effects meeting it and its relative effect size) and per changed cell (our estimate, its verdict),
 and the totals.  Exit status 0 when nothing differs, 1 when a claim or a cell does (as ``diff`` does), 2
 when A or B is none of the above.
 
@@ -27,13 +28,15 @@ from pathlib import Path
 import pandas as pd
 
 from replication.errors import fail
+from replication.evidence.criteria import CRITERIA
 from replication.evidence.scorecard import Scorecard
 from replication.paths import resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest
 from replication.scales import SCALES, report_folder
 
 CLAIM = ("claim_id",)
-CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost")
+CLAIM_FIELDS = ("verdict", "number", "runs", "robustness", "at_equal_cost",  # and each replication criterion's
+                *(f"criterion_{c.key}" for c in CRITERIA), "relative_effect")  # count of effects meeting it
 CELL = ("paper", "table", "experiment", "method", "metric", "condition")
 CELL_FIELDS = ("ours", "runs", "verdict", "reason")
 VERDICTS = {CLAIM: ("verdict", "robust", "at_equal_cost"), CELL: ("verdict",)}  # what must not move, by key

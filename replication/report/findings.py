@@ -16,7 +16,9 @@ CSVs and ``status.json``) through these names:
 - ``experiment("bis_pf")``: its runs, minutes and CPU-minutes as recorded (a multiverse's ``universes``
   recorded of those ``designed``);
 - ``scorecard()``, ``cells()``, ``times()``: the paper's claims, its published cells beside ours, and its
-  experiments' cost, as Markdown tables.
+  experiments' cost, as Markdown tables; ``criteria()``: per paper and over all, the claims meeting each
+  replication criterion (:mod:`replication.evidence.criteria`), ``surviving``: the median share of the papers'
+  effects that survives, in words.
 
 - ``parts()``: the record's parts (the experiments together, each multiverse) and what each took.
 - ``where_time_goes(by_method)``: the record's profile (``record/profile.json``, made by ``make record``)
@@ -43,10 +45,12 @@ import pandas as pd
 
 from replication import atomic
 from replication.evidence.claims import Paper, load_papers
+from replication.evidence.criteria import CRITERIA
 from replication.evidence.scorecard import Scorecard
 from replication.evidence.tables import Table, cell_value, interval, number
 from replication.paths import CONF_DIR
 from replication.record.manifest import MANIFEST, PROFILE, sha256
+from replication.report.pages.effects import surviving_said
 from replication.report.pages.recorded import STATUS
 from replication.runner.provenance import run_code_digest
 
@@ -134,6 +138,13 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
                                in rows[["table", "method", "condition", "metric", "paper_value", "ours", "runs",
                                         "verdict"]].itertuples(index=False)])
 
+    def criteria() -> str:
+        """Each replication criterion, its source, and per paper and over all the claims meeting it of those it
+        applies to, then the effects."""
+        shares = drawn.card.criteria
+        return markdown_table(["criterion", "source", *(row["paper"] for row in shares)],
+                              [[c.name, c.source, *(_share(*row[c.key]) for row in shares)] for c in CRITERIA])
+
     def verdicts(key: str) -> str:
         counted = claims[claims["paper"] == key]["verdict"].value_counts()
         return ", ".join(f"{n} {verdict}" for verdict, n in counted.items())
@@ -183,9 +194,15 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     return {"paper": papers.get(paper), "papers": papers, "page": paper,
             "record": {k: number(v) if isinstance(v, (int, float)) else v for k, v in status.items()},
             "claim": claim, "table": drawn.table, "experiment": experiment, "verdicts": verdicts,
-            "scorecard": scorecard, "cells": cells, "times": times, "parts": parts,
+            "scorecard": scorecard, "cells": cells, "times": times, "parts": parts, "criteria": criteria,
+            "surviving": surviving_said(drawn.card),
             "where_time_goes": where_time_goes, "profiled": profile.get("made"),
             "profiled_experiments": len({m["experiment"] for m in profile.get("methods", [])})}
+
+
+def _share(met: int, of: int, effects_met: int, effects: int) -> str:
+    """'1 of 5 claims (20 %); 7 of 38 effects' ('-' where the criterion applies to none)."""
+    return f"{met} of {of} claims ({100 * met / of:.0f} %); {effects_met} of {effects} effects" if of else "-"
 
 
 def _previous(before: dict | None) -> str:

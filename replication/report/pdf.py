@@ -33,7 +33,8 @@ from replication.arguments import read  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from replication.paths import CONF_DIR, experiment_names, resolve  # noqa: E402
-from replication.report.pages import glance  # noqa: E402
+from replication.evidence.criteria import CRITERIA  # noqa: E402
+from replication.report.pages import effects, glance  # noqa: E402
 from replication.report.pages.index import TITLE  # noqa: E402
 from replication.evidence.claims import Paper  # noqa: E402
 from replication.report.pages.scale import PAPER_COMMAND, scale_note  # noqa: E402
@@ -77,6 +78,11 @@ def _write_book(path: Path, reports: Path, card: Scorecard, papers: list[Paper],
     summaries, cells, rows, tallies = card.summaries, card.cells, card.rows, card.tallies
     with plt.rc_context({"pdf.fonttype": 3, "font.family": "DejaVu Sans"}), _Book(path, banner) as pdf:
         _title_page(pdf, summaries, cells, rows, glance.write(reports, papers, rows))
+        picture = effects.draw(card, reports / effects.FIGURE)  # second, after the glance, as on the index
+        if picture is not None:
+            _figure_page(pdf, "How much of each paper's effect survives", effects.surviving_said(card), picture)
+            _table_pages(pdf, "The replication criteria", _criteria_frame(card), subtitle=CRITERIA_SAID,
+                         font=TABLE_FONT)
         for paper in papers:
             counted = ", ".join(f"{n} {outcome}" for outcome, n in tally(rows[paper.key]).items())
             _table_pages(pdf, f"Scorecard: {paper.title}", _scorecard_frame(rows[paper.key], tallies),
@@ -145,6 +151,19 @@ def _scorecard_frame(rows, tallies: dict[str, str]) -> pd.DataFrame:
         "readings": [r.primary.reading.name + ("" if len(r.results) == 1 and r.multiverse is None
                                                else f"; {r.robustness}") for r in rows],
     })
+
+
+CRITERIA_SAID = ("Per paper and over all, the claims meeting each criterion of the replication projects of "
+                 "those it applies to (replication/evidence/criteria.py); shown, never combined into the verdicts")
+
+
+def _criteria_frame(card: Scorecard) -> pd.DataFrame:
+    """Each replication criterion, and per paper and over all the claims meeting it, as the index shows them."""
+    shares = card.criteria
+    return pd.DataFrame([{"criterion": c.name, "source": c.source,
+                          **{row["paper"]: f"{row[c.key][0]} of {row[c.key][1]} claims, {row[c.key][2]} of "
+                             f"{row[c.key][3]} effects" if row[c.key][1] else "-" for row in shares}}
+                         for c in CRITERIA])
 
 
 def _title_page(pdf: PdfPages, summaries: dict[str, Summary], cells: pd.DataFrame, rows: dict, picture: Path) -> None:

@@ -39,6 +39,11 @@ class ClaimSpec(Spec):
         they are given in common (its label: "likelihood evaluations per step", "time per frame (ms)")."""
         return ""
 
+    @property
+    def sized(self) -> bool:
+        """Whether it tests the paper's own size (its checks then carry the replication criteria's effects)."""
+        return False
+
 
 @dataclass(frozen=True, kw_only=True)
 class Measured(ClaimSpec):

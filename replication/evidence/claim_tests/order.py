@@ -11,6 +11,7 @@ import pandas as pd
 
 from replication.evidence.checks import Check, finite
 from replication.evidence.comparisons import Effect, OrderTest, order_test
+from replication.evidence.criteria import Replication
 from replication.evidence.inference import said_p
 from replication.evidence.original import runs_behind
 from replication.evidence.published import cells as published_cells
@@ -48,6 +49,10 @@ class Order(ClaimTest):
         tolerance: float = 0.0
         size: dict[str, Any] | None = None
 
+        @property
+        def sized(self) -> bool:
+            return self.size is not None
+
     def checks(self, records, tables):
         metric, scale = self.spec.metric, self.spec.scale
         kind = quantity(metric)
@@ -65,7 +70,7 @@ class Order(ClaimTest):
                     allowed = self.spec.tolerance * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
                     paper = self.effect(a, b, records[records["condition"] == condition].iloc[0], len(paired))
-                    verdict, difference = _order_check(better, worse, kind, scale, allowed, paper)
+                    verdict, difference, replication = _order_check(better, worse, kind, scale, allowed, paper)
                     # the line the difference better - worse is tested against: worse by at most the allowance
                     line = allowed * scale * (1 if kind.lower_is_better else -1)
                     if allowed and verdict.outcome is not Outcome.NOT_TESTABLE:
@@ -73,7 +78,7 @@ class Order(ClaimTest):
                     per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
                     work = _work(records, (a, b), condition) if kind.machine_dependent else ""  # beside a time
                     found.append(Check(what, verdict, difference, unit, line, per_run, work,
-                                       _shown_gap(paper), kind.machine_dependent))
+                                       _shown_gap(paper), kind.machine_dependent, replication))
         return found
 
     def effect(self, better: str, worse: str, ours: pd.Series, runs: int) -> Effect | None:
@@ -163,7 +168,7 @@ class EqualCost(ClaimTest):
             paired = paired[np.isfinite(paired[["baseline", "method"]]).all(axis=1)]  # both defined
             better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
             scale = self.spec.scale
-            verdict, difference = _order_check(better, worse, quantity(metric), scale, 0.0, None)
+            verdict, difference, _ = _order_check(better, worse, quantity(metric), scale, 0.0, None)
             per_run = dict(zip(paired["repetition"].astype(int), (better - worse) * scale))
             spends = f"budget {budget:.4g}; {baseline} at {chosen} spends {spent[chosen]:.4g}"
             found.append(Check(what, verdict, difference, self.spec.unit, 0.0, per_run, spends,
@@ -184,10 +189,11 @@ def _work(records: pd.DataFrame, methods: tuple[str, ...], condition: str) -> st
 
 
 def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allowed: float,
-                 paper: Effect | None) -> tuple[Verdict, Estimate]:
-    """One pair's verdict (before the reading's Holm) and the paired difference better - worse shown with
+                 paper: Effect | None) -> tuple[Verdict, Estimate, Replication | None]:
+    """One pair's verdict (before the reading's Holm), the paired difference better - worse shown with
     it, in the claim's units (``scale``): the raw difference, the margin ``allowed`` in the claim's favour
-    (in the runs' units) tested but not shown in it."""
+    (in the runs' units) tested but not shown in it; and where the paper quotes a size that favours the
+    claim and the runs test it, the two effects for the replication criteria."""
     runs = len(better)
     binary = kind.proportion
     unit = kind.high * scale if binary else scale  # yes/no outcomes are tested as 0 or 1
@@ -199,10 +205,11 @@ def _order_check(better: np.ndarray, worse: np.ndarray, kind, scale: float, allo
                         (kind.high - kind.low) * scale)
     few = too_few(runs)
     if few:
-        return few, difference
+        return few, difference, None
     if tested.tied:
-        return Verdict(Outcome.NOT_TESTABLE, _tied(float(better[0]), runs, kind, scale)), difference
-    return _order_verdict(tested, paper, unit, binary), difference
+        return Verdict(Outcome.NOT_TESTABLE, _tied(float(better[0]), runs, kind, scale)), difference, None
+    replication = tested.replication.single() if tested.replication is not None else None
+    return _order_verdict(tested, paper, unit, binary), difference, replication
 
 
 def _tied(value: float, runs: int, kind, scale: float) -> str:

@@ -11,6 +11,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from replication import atomic  # noqa: E402
+from replication.evidence.criteria import CRITERIA  # noqa: E402
 from replication.evidence.inference import detectable  # noqa: E402
 from replication.report.pages.render import html_table, render  # noqa: E402
 from replication.evidence.settings import INFERENCE  # noqa: E402
@@ -19,14 +20,29 @@ from replication.evidence.settings import INFERENCE  # noqa: E402
 def failures(table: pd.DataFrame, standard_errors: float = 2.0, control: bool = False) -> pd.DataFrame:
     """The null rows whose rate exceeds 5 % by more than ``standard_errors`` Monte Carlo standard errors: of
     the project's rules, or (``control``) of the old rules kept as controls, which decide no verdict."""
-    null = table[(table["truth"] == "null") & (table["control"].astype(bool) == control)]
+    null = table[(table["truth"] == "null") & (table["control"].astype(bool) == control) & ~_criteria(table)]
     return null[null["rate"] > INFERENCE.alpha + standard_errors * null["mc_se"]]
+
+
+def _criteria(table: pd.DataFrame) -> pd.Series:
+    """The rows of replication criteria (shown beside the verdicts, deciding none): not held to 5 %."""
+    return table["criterion"].astype(bool)
+
+
+def criteria_rates(table: pd.DataFrame) -> pd.DataFrame:
+    """The replication criteria's rows side by side: per criterion, run counts and noise, the rate of success
+    with no effect and with the paper's effect true, each with its Monte Carlo standard error."""
+    rows = table[_criteria(table)]
+    wide = rows.pivot_table(index=["test", "runs", "paper_runs", "distribution"], columns="truth",
+                            values=["rate", "mc_se"], sort=False)
+    wide.columns = [f"{value} ({truth})" for value, truth in wide.columns]
+    return wide.reset_index().round(4)
 
 
 def draw_null_rates(table: pd.DataFrame, path: Path) -> None:
     """Each null row's rate of wrong decisive verdicts with 2 Monte Carlo standard errors, by test kind and
     run count; the old rules (controls) in red; 5 % dashed."""
-    null = table[table["truth"] == "null"].copy()
+    null = table[(table["truth"] == "null") & ~_criteria(table)].copy()
     null["row"] = null["test"] + " | " + null["guards"]
     rows = list(dict.fromkeys(null.sort_values(["control", "test"])["row"]))
     fig, ax = plt.subplots(figsize=(9, 0.35 * len(rows) + 1.2))
@@ -86,6 +102,7 @@ def write_calibration_page(table: pd.DataFrame, reports: Path) -> Path:
     atomic.write_text(page, render(
         "calibration.html.j2", title="How often the verdict rules err: calibration",
         failed=failures(table), controls=failures(table, control=True), table=html_table(shown), replications=int(table["replications"].max()),
+        criteria=CRITERIA, criteria_rates=html_table(criteria_rates(table)),
         rows=len(table), floor=2.0 ** -5, equivalence_alpha=INFERENCE.equivalence_alpha,
         detect5=detectable(1.0, 5), detect100=detectable(1.0, 100)))
     return page

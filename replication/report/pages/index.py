@@ -17,11 +17,12 @@ import replication
 from replication import atomic
 from replication.paths import experiment_names
 from replication.record.manifest import PAGES
-from replication.report.pages import glance
+from replication.report.pages import effects, glance
 from replication.report.pages.recorded import recorded
 from replication.report.pages.render import render
 from replication.report.pages.scale import scale_note
 from replication.scales import QUICK_REPORTS, SCALES, page_link
+from replication.evidence.criteria import CRITERIA
 from replication.evidence.scorecard import Scorecard, tally
 from replication.evidence.schema import Summary
 from replication.evidence.summary import counts, load_summaries
@@ -79,6 +80,7 @@ def write_index(reports: Path, card: Scorecard) -> Path:
     atomic.save(reports / "summary.csv", lambda tmp: card.cell_table.to_csv(tmp, index=False))  # exports, never read
     atomic.save(reports / "claims.csv", lambda tmp: card.claims.to_csv(tmp, index=False))
     glance.draw(glance.lines(papers, rows, record["claims"] if record else None), reports / glance.FIGURE)
+    drawn_effects = effects.draw(card, reports / effects.FIGURE)
     page = reports / "index.html"
     atomic.write_text(
         page,
@@ -96,6 +98,11 @@ def write_index(reports: Path, card: Scorecard) -> Path:
             links={name: page_link(s.name, s.scale) for name, s in summaries.items()},  # the scorecard's evidence
             record=record,
             tallies=tallies,
+            criteria=CRITERIA,
+            shares=card.criteria,
+            per_claim=[row for paper in papers for row in rows[paper.key]],
+            effects={"drawn": drawn_effects is not None, "file": effects.FIGURE, "alt": effects.ALT,
+                     "surviving": effects.surviving_said(card)},
             rules=rules(),
             counts=counts(cells, summaries),
             benchmark=(reports / "benchmark" / "index.html").exists(),
