@@ -5,7 +5,8 @@
 # make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
 #                  (where one run's time goes: python benchmarks/profile_run.py EXPERIMENT METHOD [TEXT] [--scale paper])
 # make readings    run every paper's multiverse (conf/experiment/*_readings.yaml) at SCALE (at paper: what the record
-#                  lacks, universe by universe, then recorded)
+#                  lacks, universe by universe, then recorded); on a cluster: ADDRESS=tcp://host:8786 (dask, the
+#                  default BACKEND) or BACKEND=ray ADDRESS=head-host:6379 (docs/reproducibility.md, "On many machines")
 # make docs        the API reference from the docstrings (pdoc), into reports/api/
 # make calibrate   simulate every verdict rule's error rates (reports/calibration.csv; kept while the deciding code it simulates is unchanged)
 # make record      write the paper-scale record (record/) from a store holding every paper-scale run (make replicate SCALE=paper does),
@@ -23,6 +24,9 @@ BIN := $(VENV)/bin
 SCALE ?= quick
 JOBS ?= 2
 N ?= 200
+BACKEND ?= dask
+ADDRESS ?=
+CLUSTER := $(if $(ADDRESS),parallel.backend=$(BACKEND) parallel.address=$(ADDRESS))
 EXPERIMENTS := $(sort $(basename $(notdir $(wildcard conf/experiment/*.yaml))))
 READINGS := $(sort $(basename $(notdir $(wildcard conf/experiment/*_readings.yaml))))
 # The multiverses run with make replicate at the quick scale (a small design each); at paper scale
@@ -80,7 +84,7 @@ replicate: setup
 # At SCALE=paper the universes the record holds as this code computes them are read from it, not run
 # again, and every universe run whole is recorded: stopped part-way, the next call goes on from there.
 readings: setup
-	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(READINGS)) scale=$(SCALE) n_jobs=$(JOBS)
+	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(READINGS)) scale=$(SCALE) n_jobs=$(JOBS) $(CLUSTER)
 	$(if $(filter paper,$(SCALE)),$(BIN)/python -m replication record experiment=$(subst $(space),$(comma),$(READINGS)) && $(BIN)/python -m replication findings)
 	$(BIN)/python -m replication.report.pdf
 

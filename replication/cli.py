@@ -154,7 +154,8 @@ def interrupted(store=None, runs=None) -> None:
 def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
     from replication.record.layer import beneath, missing, said
-    from replication.runner.execute import BackendError, execute
+    from replication.runner.backends import BackendError
+    from replication.runner.execute import execute
     from replication.runner.failures import exit_if_failed
     from replication.runner.store import Store
     from replication.runner.validate import prepare
@@ -241,7 +242,8 @@ def run_multiverse(cfg: DictConfig) -> None:
     """Run every universe of a paper's multiverse (:mod:`replication.runner.multiverse`) into its base
     experiments' stores, then write its report and the index."""
     from replication.record.layer import missing, reader, said, universes_beneath
-    from replication.runner.execute import BackendError, execute
+    from replication.runner.backends import BackendError
+    from replication.runner.execute import execute
     from replication.runner.multiverse import load
     from replication.runner.validate import parallel_settings
 

@@ -1,9 +1,8 @@
-"""Beyond one machine: the dask and ray backends (a local cluster standing in for a real one)
-and the threading backend store the same records as loky; a local cluster listens on the loopback alone;
+"""Beyond one machine: the dask and ray backends (clusters started from their command lines on the loopback,
+as on real machines) and the threading backend store the same records as loky; a local cluster listens on the loopback alone;
 one SIGTERM stops every local backend and everything it started."""
 
 import ipaddress
-import logging
 import os
 import secrets
 import shutil
@@ -21,7 +20,8 @@ from conftest import PROJECT_ROOT
 from test_reliability import INTERRUPTED, NEEDS_PROC, command, descendants, processes, still_running
 
 from replication.runner.config import expand
-from replication.runner.execute import CLUSTER_PACKAGES, TIMING_COLUMNS, execute
+from replication.runner.backends import CLUSTER_PACKAGES
+from replication.runner.execute import TIMING_COLUMNS, execute
 from replication.runner.store import Store
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
@@ -38,11 +38,31 @@ pytestmark = [pytest.mark.e2e, pytest.mark.xdist_group("clusters")]
 
 @pytest.fixture(scope="module")
 def cluster():
-    distributed = pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
-    ) as local:
-        yield local
+    """A dask cluster started as on real machines, from the command lines a cluster's are started with: a
+    ``dask scheduler`` and two ``dask worker`` processes of one thread each, here on the loopback; the
+    scheduler's address."""
+    pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable))
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    started = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                                 "--dashboard-address", "127.0.0.1:0", "--no-show"], **quiet)]
+    try:
+        started += [subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--host", "127.0.0.1",
+                                      "--dashboard-address", "127.0.0.1:0", "--name", f"worker-{i}"], **quiet)
+                    for i in range(2)]
+        from distributed import Client
+
+        with Client(address, timeout=60) as client:
+            client.wait_for_workers(2, timeout=120)
+        yield address
+    finally:
+        for process in reversed(started):  # the workers, then the scheduler
+            process.terminate()
+            process.wait(timeout=60)
 
 
 def loky_records(runs: list, tmp_path) -> pd.DataFrame:
@@ -68,12 +88,12 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, c
     expected = loky_records(runs, tmp_path)
 
     dask = Store(tmp_path / "dask", "hspf_ungm")
-    assert execute(runs, dask, backend="dask", address=cluster.scheduler_address, progress=False) == len(runs)
+    assert execute(runs, dask, backend="dask", address=cluster, progress=False) == len(runs)
     pd.testing.assert_frame_equal(deterministic_columns(dask.load(runs)), expected)
 
     assert_command_line_resumes_on_cluster(
         cli, tmp_path, runs, expected,
-        "parallel.backend=dask", f"parallel.address={cluster.scheduler_address}", timeout=120,
+        "parallel.backend=dask", f"parallel.address={cluster}", timeout=120,
     )
 
 
@@ -168,7 +188,7 @@ def test_other_local_backends_store_the_same_records_as_loky(make_cfg, tmp_path,
 def test_an_unreachable_ray_address_is_one_line_at_once(make_cfg, tmp_path):
     """ray.init retries an address that does not answer for minutes; the runner checks it first."""
     pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
-    from replication.runner.execute import BackendError
+    from replication.runner.backends import BackendError
 
     import ray
 
@@ -185,7 +205,7 @@ def test_a_local_dask_cluster_serves_its_dashboard_on_the_loopback_only():
     pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
     import distributed
 
-    from replication.runner.execute import _dask_client
+    from replication.runner.backends import _dask_client
 
     with _dask_client(None, 1):
         client = distributed.get_client()
@@ -197,7 +217,7 @@ def test_unreachable_scheduler_is_one_clear_error(make_cfg, tmp_path):
     pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
     import dask
 
-    from replication.runner.execute import BackendError
+    from replication.runner.backends import BackendError
 
     runs = expand(make_cfg("hspf_ungm", *TINY))
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}), pytest.raises(BackendError) as error:

@@ -1,12 +1,8 @@
 """Fan runs out with joblib and store each record the moment it arrives.
 
-Where the runs go is ``parallel.backend`` (see ``conf/config.yaml``): ``loky``
-worker processes on this machine (the default), ``threading``, or a cluster:
-``dask`` (a ``distributed`` scheduler at ``parallel.address``, or a local
-cluster of ``n_jobs`` worker processes on the loopback when no address is given) or ``ray``
-(``ray.init(address=parallel.address)``, an address first checked to answer; no address: a new
-local cluster, never a stale one a past run left named in ray's files; ray's joblib backend cannot
-stream results, so its records come back and are stored a batch at a time).  Wherever a run is computed, its
+Where the runs go is ``parallel.backend`` (see ``conf/config.yaml``), one of
+:data:`~replication.runner.backends.BACKENDS`: worker processes on this machine or a dask or ray
+cluster (a backend that cannot stream, ray's, sends its records back a batch at a time).  Wherever a run is computed, its
 record is a pure function of its identity and seed, so every backend stores
 the same numbers; only the records are sent back, and only this process
 writes the store.  Cluster workers need this package (and the same numpy,
@@ -14,30 +10,22 @@ scipy and numba) installed; tracking runs also need the scene data at the
 same relative path.
 """
 
-import asyncio
-import importlib.util
-import ipaddress
-import logging
-import os
-import signal
-import socket
 import sys
-import threading
 import warnings
 from collections.abc import Iterator
-from contextlib import closing, contextmanager, nullcontext
+from contextlib import closing
 
 import numpy as np
-from joblib import Parallel, delayed, effective_n_jobs, parallel_config, register_parallel_backend
+from joblib import Parallel, delayed, effective_n_jobs
 from tqdm.auto import tqdm
 
 import replication
 from replication.condition import Condition
 from replication.errors import RunFailed
 from replication.run import Run
+from replication.runner.backends import BACKENDS, parallel_backend
 from replication.runner.bounds import MANY_RUNS
 from replication.runner.failures import failure
-from replication.runner.lifeline import start_worker
 from replication.runner.memory import one_thread, retain_freed_memory
 from replication.runner.provenance import provenance
 from replication.runner.store import Store, summarise
@@ -47,17 +35,7 @@ from replication.tasks import TASKS
 # machine- and moment-dependent: left out of determinism checks
 TIMING_COLUMNS = ("wall_s", "cpu_s", "ms_per_step", "cpu_ms_per_step", "ms_per_frame", "cpu_ms_per_frame", "filter_s",
                   "cpu_filter_s", "fps", "load_1m", "reference_ms", "computed_at")
-BACKENDS = ("loky", "threading", "dask", "ray")
-CLUSTER_PACKAGES = {"dask": "distributed", "ray": "ray"}  # the import each cluster backend needs
-# ray's joblib backend returns whole lists only (no return_as="generator_unordered"): its records are
-# sent back, and stored, a batch of RUNS_PER_WORKER runs per worker at a time
-LIST_ONLY_BACKENDS = ("ray",)
-RUNS_PER_WORKER = 2
-STOP_S = 1.0  # an interrupted local dask worker is killed after this long, its run unfinished
-
-
-class BackendError(RuntimeError):
-    """A parallel backend that cannot be used as configured; the message is meant for the user as is."""
+RUNS_PER_WORKER = 2  # a backend that cannot stream sends its records back this many runs per worker at a time
 
 
 def perform(run: Run) -> dict:
@@ -99,195 +77,6 @@ def _performed(run: Run) -> dict:
     }
 
 
-def check_backend(backend: str, address: str | None = None) -> None:
-    """Fail at once, before any work, on a backend that cannot run here (no network access)."""
-    if backend not in BACKENDS:
-        raise BackendError(f"parallel.backend must be one of {', '.join(BACKENDS)}; got {backend!r}")
-    if address and backend not in CLUSTER_PACKAGES:
-        raise BackendError(
-            f"parallel.address is for the {' and '.join(CLUSTER_PACKAGES)} backends, "
-            f"not parallel.backend={backend}"
-        )
-    if address is not None and not isinstance(address, str):
-        raise BackendError(f"parallel.address must be a string such as tcp://host:8786; got {address!r}")
-    package = CLUSTER_PACKAGES.get(backend)
-    if package and importlib.util.find_spec(package) is None:
-        raise BackendError(f"parallel.backend={backend} needs the {package} package: pip install {package}")
-
-
-@contextmanager
-def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None = None) -> Iterator[None]:
-    """The joblib configuration for ``backend``, with its cluster connected for the duration.
-
-    ``n_jobs`` is the number of local workers (loky, threading, a local dask
-    cluster); on an existing dask or ray cluster every worker is used.
-    """
-    check_backend(backend, address)
-    if backend == "dask":
-        with _dask_client(address, n_jobs), parallel_config(backend="dask"):
-            yield
-    elif backend == "ray":
-        with _ray_cluster(address), parallel_config(backend="ray", n_jobs=-1 if address else n_jobs):
-            yield
-    elif backend == "loky":
-        with parallel_config(backend="loky", n_jobs=n_jobs, initializer=start_worker, initargs=(os.getpid(),)):
-            yield
-    else:
-        with parallel_config(backend=backend, n_jobs=n_jobs):
-            yield
-
-
-def _answers(address: str, seconds: float = 10.0) -> None:
-    """A TCP connection to a cluster's ``host:port`` (``ray://host:port`` too) opens within ``seconds``, else
-    OSError; ``auto`` and other names without a port are left to the cluster's own client."""
-    host, _, port = address.removeprefix("ray://").rpartition(":")
-    if host and port.isdigit():
-        socket.create_connection((host, int(port)), timeout=seconds).close()
-
-
-@contextmanager
-def _ray_cluster(address: str | None) -> Iterator[None]:
-    """ray connected for the duration, and shut down after if it was started here: the cluster at ``address``
-    (first checked to answer), or, with no address, a new local cluster on the loopback alone
-    (:func:`_ray_on_the_loopback`), never one named by ``RAY_ADDRESS`` or by a file a past one left."""
-    import ray
-
-    _register_ray()
-    if ray.is_initialized():  # a session of the caller's own: used as it is, and left running
-        yield
-        return
-    if address:  # ray.init retries an address that does not answer for minutes, printing every 5 s
-        try:
-            _answers(address)
-        except OSError as error:
-            raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
-    with nullcontext() if address else _ray_on_the_loopback():
-        try:
-            with _sigterm_kept(), warnings.catch_warnings():
-                warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
-                ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
-                         **({} if address else {"include_dashboard": False}))  # the runner never reads it
-        except (ConnectionError, RuntimeError, ValueError) as error:
-            where = f"ray at parallel.address={address}" if address else "ray on this machine"
-            hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
-            raise BackendError(f"cannot start or reach {where}: {_one_line(error)}{hint}") from None
-        try:
-            node = ray.util.get_node_ip_address()
-            if not (address or ipaddress.ip_address(node).is_loopback):
-                raise BackendError(f"a local ray cluster started on {node}, not on the loopback (127.0.0.1): this "
-                                   f"ray release ignores {RAY_LOCAL_ONLY}=0; use parallel.backend=dask")
-            yield
-        finally:
-            ray.shutdown()
-
-
-def _register_ray() -> None:
-    """ray's joblib backend as ``ray``, aborting (an interrupt, a run's error) without a new pool: joblib leaves
-    the pool of a ``with Parallel()`` block ready for more work, which for ray's actors takes 10 s and more on
-    a loaded machine, after a SIGTERM too; the runner submits nothing to a pool after an abort."""
-    from ray.util.joblib.ray_backend import RayBackend
-
-    class Stopping(RayBackend):
-        def abort_everything(self, ensure_ready: bool = True) -> None:
-            super().abort_everything(ensure_ready=False)
-
-    register_parallel_backend("ray", Stopping)
-
-
-RAY_LOCAL_ONLY = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # "0": ray without clusters, its node on the loopback
-
-
-@contextmanager
-def _ray_on_the_loopback() -> Iterator[None]:
-    """While it lasts, a local ray cluster takes the loopback (127.0.0.1) for its node's address, and every
-    service it starts (GCS, raylet, object manager, workers, agents) listens there alone, as a local dask
-    cluster does.  On Linux ray takes the machine's own address instead and listens on every interface; it
-    takes the loopback where clusters of several machines are not enabled (:data:`RAY_LOCAL_ONLY` ``=0``,
-    macOS's and Windows's default).  The processes ray starts read that variable from their environment;
-    this process read it once, when ray was imported, into the constant set here too."""
-    from ray._private import ray_constants
-
-    saved = os.environ.get(RAY_LOCAL_ONLY), ray_constants.ENABLE_RAY_CLUSTER
-    os.environ[RAY_LOCAL_ONLY], ray_constants.ENABLE_RAY_CLUSTER = "0", False
-    try:
-        yield
-    finally:
-        ray_constants.ENABLE_RAY_CLUSTER = saved[1]
-        if saved[0] is None:
-            os.environ.pop(RAY_LOCAL_ONLY, None)
-        else:
-            os.environ[RAY_LOCAL_ONLY] = saved[0]
-
-
-@contextmanager
-def _sigterm_kept() -> Iterator[None]:
-    """This process's SIGTERM handler put back after the block.  ``ray.init`` installs its own, twice: one
-    that exits at once, and its core worker's, which aborts: either would leave ray's processes and the
-    workers' runs behind, where the runner's (:func:`~replication.runner.lifeline.stop_on_sigterm`) stops
-    them and keeps every run stored."""
-    previous = signal.getsignal(signal.SIGTERM)
-    try:
-        yield
-    finally:
-        if previous is not None and threading.current_thread() is threading.main_thread():
-            signal.signal(signal.SIGTERM, previous)
-
-
-@contextmanager
-def _interrupts_ignored() -> Iterator[None]:
-    """SIGINT ignored while worker processes start, so that they keep ignoring it (an ignored
-    signal stays ignored across exec, and Python leaves it so); restored afterwards."""
-    if threading.current_thread() is not threading.main_thread():
-        yield  # only the main thread may set handlers; it is the one a Ctrl-C reaches anyway
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-@contextmanager
-def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
-    from distributed import Client, LocalCluster
-
-    cluster = None
-    try:
-        if address:
-            client = Client(address)
-        else:
-            with _interrupts_ignored():  # the workers inherit it: Ctrl-C is for this process alone
-                cluster = LocalCluster(
-                    n_workers=n_jobs if n_jobs > 0 else None,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address="127.0.0.1:0",  # the dashboard too on the loopback alone, as the scheduler
-                    silence_logs=logging.ERROR,
-                )
-            client = Client(cluster)
-    except (OSError, TimeoutError, ValueError) as error:
-        if cluster is not None:
-            cluster.close()
-        where = f"the dask scheduler at parallel.address={address}" if address else "a local dask cluster"
-        raise BackendError(f"cannot reach {where}: {_one_line(error)}") from None
-    try:
-        yield
-    except BaseException:  # interrupted: stop the local workers now, not once their runs end (a nanny waits 4 s)
-        if cluster is not None:
-            cluster.sync(_stop_now, cluster)
-        raise
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-
-
-async def _stop_now(cluster) -> None:
-    """Close a local dask cluster's workers at once: each nanny kills its worker's process after
-    :data:`STOP_S`, mid-run (a process slow to be reaped is left to the cluster's own close)."""
-    await asyncio.gather(*(nanny.close(timeout=STOP_S) for nanny in cluster.workers.values()), return_exceptions=True)
-
-
 def _records(pending: list[Run], streamed: bool) -> Iterator[dict]:
     """Each run's record as it finishes, from the joblib backend in force.
 
@@ -309,10 +98,6 @@ def _records(pending: list[Run], streamed: bool) -> Iterator[dict]:
     with Parallel() as parallel:  # one pool for every batch
         for start in range(0, len(pending), batch):
             yield from parallel(delayed(perform)(run) for run in pending[start : start + batch])
-
-
-def _one_line(error: BaseException) -> str:
-    return " ".join(str(error).split()) or error.__class__.__name__
 
 
 def forecast(runs: list[Run], pending: list[Run], store: Store, n_jobs: int, sample: int = 5) -> str:
@@ -394,7 +179,7 @@ def execute(
         mininterval=1.0,
     )
     with bar, parallel_backend(backend, n_jobs, address), closing(
-        _records(pending, streamed=backend not in LIST_ONLY_BACKENDS)
+        _records(pending, streamed=BACKENDS[backend].streams)
     ) as records:
         for record in records:
             run = by_id[record["run_id"]]

@@ -28,7 +28,7 @@ from replication.paths import experiment_names, resolve
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale, planned
 from replication.scales import at_scale
-from replication.runner.execute import BackendError, check_backend
+from replication.runner.backends import BackendError, check_backend
 from replication.runner.variant import as_shipped
 
 PARALLEL_KEYS = ("backend", "address")
