@@ -133,8 +133,10 @@ def test_a_claim_meets_a_criterion_when_each_of_its_sized_effects_does_and_says_
     shares = criteria.shares({"p": [both, criteria.assess([_check(strong)], sized=True),
                                     criteria.assess([], sized=False)]})
     # of the 2 claims it applies to, one meets it; of their 3 effects, two
-    assert shares[0]["claims"] == 3 and shares[0]["significant"] == (1, 2, 2, 3)
-    assert shares[-1]["paper"] == "all" and shares[-1]["significant"] == (1, 2, 2, 3)
+    assert shares[0]["claims"] == 3 and shares[0]["significant"] == criteria.Share(1, 2, 2, 3)
+    assert str(shares[0]["significant"]) == "1 of 2 claims (50 %); 2 of 3 effects"
+    assert str(criteria.Share(0, 0, 0, 0)) == "-"
+    assert shares[-1]["paper"] == "all" and shares[-1]["significant"] == criteria.Share(1, 2, 2, 3)
     median, low, high, claims = criteria.surviving([both, criteria.assess([_check(strong)], sized=True)], 999, 1)
     assert claims == 2 and median == pytest.approx(np.median([0.5, 1.0])) and low <= median <= high
 

@@ -21,6 +21,7 @@ simulated experiments.
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
+from functools import cached_property
 
 import numpy as np
 from scipy import stats
@@ -214,8 +215,13 @@ class Assessed:
     effects: tuple[Replication, ...] = ()
     why_not: str = ""
 
+    @cached_property
+    def _met(self) -> dict[str, int]:
+        return {c.key: sum(bool(c.met(r)) for r in self.effects) for c in CRITERIA}
+
     def met(self, key: str) -> int:
-        return sum(bool(CRITERION[key].met(r)) for r in self.effects)
+        """How many of the claim's effects meet criterion ``key``."""
+        return self._met[key]
 
     def holds(self, key: str) -> bool | None:
         """Whether every effect of the claim meets criterion ``key`` (None: not applicable)."""
@@ -248,17 +254,39 @@ def assess(checks, sized: bool) -> Assessed:
     return Assessed(why_not="not applicable: no check of its size was testable here")
 
 
+@dataclass(frozen=True)
+class Share:
+    """How many of the claims a criterion applies to meet it (``met`` of ``of``), and of their sized effects."""
+
+    met: int
+    of: int
+    effects_met: int
+    effects: int
+
+    @property
+    def claims_said(self) -> str:
+        return f"{self.met} of {self.of} claims ({100 * self.met / self.of:.0f} %)"
+
+    @property
+    def effects_said(self) -> str:
+        return f"{self.effects_met} of {self.effects} effects"
+
+    def __str__(self) -> str:
+        """'1 of 5 claims (20 %); 7 of 38 effects', or '-' where the criterion applies to no claim."""
+        return f"{self.claims_said}; {self.effects_said}" if self.of else "-"
+
+
 def shares(assessed: dict[str, list[Assessed]]) -> list[dict]:
     """Per paper and over all (``assessed``: each paper's claims), how many meet each criterion of those it
     applies to, as the OSC and RPCB tables count them, by claim and by effect: {"paper", "claims", key:
-    (claims meeting it, claims it applies to, effects meeting it, effects)}."""
+    :class:`Share`}."""
     rows = []
     for paper, claims in [*assessed.items(), ("all", [a for claims in assessed.values() for a in claims])]:
         applicable = [a for a in claims if a.effects]
         effects = sum(len(a.effects) for a in applicable)
         rows.append({"paper": paper, "claims": len(claims),
-                     **{c.key: (sum(bool(a.holds(c.key)) for a in applicable), len(applicable),
-                                sum(a.met(c.key) for a in applicable), effects) for c in CRITERIA}})
+                     **{c.key: Share(sum(bool(a.holds(c.key)) for a in applicable), len(applicable),
+                                     sum(a.met(c.key) for a in applicable), effects) for c in CRITERIA}})
     return rows
 
 

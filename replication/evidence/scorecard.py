@@ -10,6 +10,7 @@ per claim.
 
 from collections import Counter
 from dataclasses import dataclass
+from functools import cached_property
 
 import pandas as pd
 
@@ -48,7 +49,7 @@ class ClaimRow:
     def verdict(self) -> Verdict:
         return self.primary.verdict
 
-    @property
+    @cached_property
     def assessed(self) -> Assessed:
         """The claim under the replication literature's criteria (:mod:`replication.evidence.criteria`): its
         first reading's sized checks, the paper's effect and ours in each."""

@@ -119,7 +119,7 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     def experiment(name: str) -> dict:
         if name not in status["experiments"]:
             raise LookupError(f"the record holds no experiment {name!r}")
-        return {k: v if isinstance(v, dict) else number(v) for k, v in status["experiments"][name].items()}
+        return {k: v if isinstance(v, (dict, list)) else number(v) for k, v in status["experiments"][name].items()}
 
     def scorecard() -> str:
         rows = claims[claims["paper"] == paper]
@@ -143,7 +143,7 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         applies to, then the effects."""
         shares = drawn.card.criteria
         return markdown_table(["criterion", "source", *(row["paper"] for row in shares)],
-                              [[c.name, c.source, *(_share(*row[c.key]) for row in shares)] for c in CRITERIA])
+                              [[c.name, c.source, *(str(row[c.key]) for row in shares)] for c in CRITERIA])
 
     def verdicts(key: str) -> str:
         counted = claims[claims["paper"] == key]["verdict"].value_counts()
@@ -155,9 +155,12 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         for name in (n for n in names if n in status["experiments"]):
             shown, counts = experiment(name), status["experiments"][name]
             universes = f"{counts['universes']} of {counts['designed']}" if counts.get("designed") else ""
+            load = counts.get("load_1m")
             rows.append([f"`{name}`", shown["runs"], universes, shown["minutes"], shown["cpu_minutes"],
-                         _previous(counts.get("before"))])
+                         shown.get("thread_cpu_minutes", ""), f"{number(load[0])} / {number(load[1])}" if load else "",
+                         shown.get("reference_ms", ""), _previous(counts.get("before"))])
         return markdown_table(["experiment", "runs", "universes", "minutes (2 workers)", "CPU-minutes",
+                               "thread CPU-minutes", "load (median / max)", "reference work (ms)",
                                "its previous recording"], rows)
 
     def parts() -> str:
@@ -198,11 +201,6 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
             "surviving": surviving_said(drawn.card),
             "where_time_goes": where_time_goes, "profiled": profile.get("made"),
             "profiled_experiments": len({m["experiment"] for m in profile.get("methods", [])})}
-
-
-def _share(met: int, of: int, effects_met: int, effects: int) -> str:
-    """'1 of 5 claims (20 %); 7 of 38 effects' ('-' where the criterion applies to none)."""
-    return f"{met} of {of} claims ({100 * met / of:.0f} %); {effects_met} of {effects} effects" if of else "-"
 
 
 def _previous(before: dict | None) -> str:

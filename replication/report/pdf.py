@@ -160,9 +160,7 @@ CRITERIA_SAID = ("Per paper and over all, the claims meeting each criterion of t
 def _criteria_frame(card: Scorecard) -> pd.DataFrame:
     """Each replication criterion, and per paper and over all the claims meeting it, as the index shows them."""
     shares = card.criteria
-    return pd.DataFrame([{"criterion": c.name, "source": c.source,
-                          **{row["paper"]: f"{row[c.key][0]} of {row[c.key][1]} claims, {row[c.key][2]} of "
-                             f"{row[c.key][3]} effects" if row[c.key][1] else "-" for row in shares}}
+    return pd.DataFrame([{"criterion": c.name, "source": c.source, **{row["paper"]: str(row[c.key]) for row in shares}}
                          for c in CRITERIA])
 
 
