@@ -187,6 +187,13 @@ def test_grades_by_hand():
     assert split.outside == ("resample_count",)  # every recorded run resampled 12 times: no spread to allow 13
     assert grade(rmse=2.9).outside == () and grade(rmse=9.0).outside == () and grade(rmse=30.0).outside == ("rmse",)
     assert graded(run, ("x",), recorded, {"failure": "rmse is not finite"}, peers).outside == ("failure",)
+    # a result the record lacks differs where this code made the record, and is new where other code did
+    from replication.record.verify import compare
+
+    assert compare(recorded, {**recorded, "fp_duplicate": 2}) == (("fp_duplicate", None, 2),)
+    assert compare(recorded, {**recorded, "fp_duplicate": 2}, other_code=True) == ()
+    assert compare(recorded, {k: v for k, v in recorded.items() if k != "rmse"}, other_code=True) == (
+        ("rmse", 2.0, None),)  # a result the record has and this code lacks still differs
 
 
 def test_verify_on_the_command_line_prints_the_difference_and_fails(make_cfg, tmp_path):

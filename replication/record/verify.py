@@ -211,13 +211,16 @@ def compared(column: str) -> bool:
     return column not in (*NOT_COMPARED, *LABELS, FAILURE) and not column.startswith((*PARAMETERS, PREFIX, UNIVERSE))
 
 
-def compare(row: dict, now: dict) -> tuple[tuple[str, object, object], ...]:
+def compare(row: dict, now: dict, other_code: bool = False) -> tuple[tuple[str, object, object], ...]:
     """The columns in which a recomputed record ``now`` differs from the recorded ``row`` in any bit (a value
-    one has and the other lacks differs too; a series the record does not keep is not compared)."""
+    one has and the other lacks differs too; a series the record does not keep is not compared).  A run the
+    record holds from ``other_code`` (its key is not this code's) is compared on what the record says: a
+    result this code adds is new, not a difference."""
     if row.get(FAILURE) is not None or "failure" in now:
         same = row.get(FAILURE) == now.get("failure")
         return () if same else ((FAILURE, row.get(FAILURE), now.get("failure")),)
-    columns = [k for k in dict.fromkeys([*row, *(k for k in now if k not in SERIES)]) if compared(k)]
+    added = (k for k in now if k not in SERIES and not (other_code and k not in row))
+    columns = [k for k in dict.fromkeys([*row, *added]) if compared(k)]
     return tuple((k, row.get(k), now.get(k)) for k in columns if not same_value(row.get(k), now.get(k)))
 
 
@@ -264,7 +267,7 @@ def first_frame(a, b, within: Tolerance) -> int | None:
 def graded(run: Run, strata: tuple[str, ...], row: dict, now: dict, peers: list[dict]) -> Recomputed:
     """``run`` graded against its recorded ``row``; ``peers`` are the recorded rows of its cell, whose spread
     (``row`` left out: the draw it replaces) a diverged run is held against."""
-    columns = compare(row, now)
+    columns = compare(row, now, other_code=run is not None and row.get("run_key") != run.key)
     peers = [peer for peer in peers if (peer.get("run_key"), peer.get("repetition")) != (row.get("run_key"),
                                                                                         row.get("repetition"))]
     beyond = tuple(c for c, a, b in columns if not same_value(a, b, tolerance(c, a if a is not None else b)))
