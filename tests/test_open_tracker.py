@@ -177,3 +177,62 @@ def test_the_matched_centre_error_averages_the_centre_distances_of_the_clear_mot
     matches = clear_mot_matches(truth, found)
     assert matches[["frame", "truth_id", "hypothesis_id"]].values.tolist() == [[1, 1, 7], [2, 1, 7]]
     assert matched_centre_error(truth, found, matches) == pytest.approx((1.0 + 2.0) / 2)  # track 8 matches nothing
+
+
+def test_a_patience_in_seconds_is_converted_by_the_frame_rate_and_one_in_frames_is_kept():
+    from replication.filters.track_management import in_frames
+
+    assert in_frames({"seconds": 0.7, "min_rho": None}, 7.0) == {"frames": 5, "min_rho": None}  # 4.9 frames
+    assert in_frames({"seconds": 0.7}, 25.0) == {"frames": 18}  # 17.5 rounds to even: 18
+    assert in_frames({"seconds": 0.01}, 7.0) == {"frames": 1}  # never less than a frame
+    assert in_frames({"frames": 3, "min_iou": 0.3}, 30.0) == {"frames": 3, "min_iou": 0.3}
+    with pytest.raises(ValueError, match="not both"):
+        in_frames({"frames": 3, "seconds": 1.0}, 7.0)
+
+
+def test_a_track_whose_box_is_off_its_person_explains_the_persons_detection_by_cover_not_by_iou():
+    """The detection (20 x 40) lies wholly inside a track's box twice its size: IoU 0.5 x 0.5 = 0.25 < 0.3, so the
+    IoU rule starts a second track on the person; the cover rule (the detection's whole area is inside) does not."""
+    person, track = np.array([[10.0, 10, 20, 40]]), np.array([[0.0, 0, 40, 80]])
+    from replication.filters.track_management import cover_matrix
+
+    assert cover_matrix(person, track)[0, 0] == 1.0 and cover_matrix(track, person)[0, 0] == 0.25
+    assert len(Initiator(frames=1, explained_iou=0.3).step(person, track)) == 1
+    assert len(Initiator(frames=1, explained_iou=0.3, explained_by="cover").step(person, track)) == 0
+    with pytest.raises(ValueError, match="explained_by"):
+        Initiator(explained_by="centre")
+
+
+@pytest.mark.parametrize("box", ["estimate", "detection", "average"])
+def test_a_shown_track_outputs_its_estimate_the_associated_detection_or_their_mean(box):
+    """The square's detections are offset 4 px to the right of it: with ``box: detection`` every frame with a
+    detection outputs exactly the detection's box, with ``average`` the mean of it and the filter's estimate."""
+    class Offset(_Square):
+        detections = _Square.detections.assign(x=_Square.detections["x"] + 4.0)
+
+    cache: dict = {}
+
+    def new_model(image, box_):
+        histogram = ColourHistogram(bins=(8, 8, 4), kernel="epanechnikov", grid=(8, 8))
+        return BoostedBoxModel(box_, ColourLikelihood.from_frame(image, box_, histogram, 0.1), cache=cache,
+                               step_sd=(2.0, 2.0, 0.5, 0.5), alpha=0.5)
+
+    outputs = {}
+    for kind in ("estimate", box):
+        tracker = ParticleTracker(builder("mipf")(n_particles=200), new_model, Initiator(frames=2),
+                                  Deleter(frames=3, min_rho=None), output="detected", box=kind)
+        outputs[kind] = {f: b for f, ids, b in tracker.track(Offset(), range(1, 12), np.random.default_rng(0)) if len(ids)}
+    given = {int(f): rows[["x", "y", "w", "h"]].to_numpy(float) for f, rows in Offset.detections.groupby("frame")}
+    for frame in range(5, 11):  # tracked frames after the birth frame (4), each with its detection
+        expected = {"estimate": outputs["estimate"][frame], "detection": given[frame],
+                    "average": (outputs["estimate"][frame] + given[frame]) / 2}[box]
+        assert np.allclose(outputs[box][frame], expected, rtol=0, atol=1e-12)
+    assert not np.allclose(outputs["estimate"][6], given[6])  # the estimate is the filter's own box
+    with pytest.raises(ValueError, match="unknown box"):
+        ParticleTracker(builder("mipf")(n_particles=10), new_model, Initiator(), Deleter(), box="median")
+
+
+def test_a_patience_whose_frames_are_unset_by_a_config_takes_its_seconds():
+    from replication.filters.track_management import in_frames
+
+    assert in_frames({"frames": None, "seconds": 1.4, "min_rho": None}, 14.0) == {"frames": 20, "min_rho": None}

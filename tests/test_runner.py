@@ -113,6 +113,15 @@ def test_model_sweeps_share_data_per_condition(make_cfg):
     assert first["PFT=10;N=100"].rng("data").random() != a.rng("data").random()
 
 
+def test_a_methods_only_block_reads_a_key_inside_a_block(make_cfg):
+    """bis_pf_pets_pipeline runs the references once per sequence: their only: names dotted keys."""
+    runs = expand(make_cfg("bis_pf_pets_pipeline", "scale=paper", "experiment.runs.paper=1"))
+    sort = [r for r in runs if r.method == "SORT"]
+    assert sorted(r.condition.get("scene") for r in sort) == ["eth_sunnyday", "mot16_11", "tud_campus"]
+    assert all(r.model["association"]["box"] == "estimate" and r.model["deaths"]["seconds"] == 0.2 for r in sort)
+    assert sum(r.method == "MIPF" for r in runs) == 3 * 3 * 2 * 3  # sequences x boxes x births x deaths
+
+
 def test_a_model_sweep_may_set_a_key_inside_a_block_and_leaves_the_block_of_the_others_alone(make_cfg):
     runs = expand(make_cfg("bis_pf_pets_tuning", "scale=quick", "experiment.runs.quick=1"))
     frames = {(r.condition.get("births.frames"), r.model["births"]["frames"]) for r in runs}

@@ -17,8 +17,10 @@ Per frame, a particle tracker: associates the detections with the tracks' boxes 
 previous frame; steps the joint filter (each target's proposal fed its detection); marks
 each track supported or not and ends the dead ones; outputs the tracks alive (by
 ``output: supported``, in frames where they are supported; ``detected``, where a detection is
-associated with them, as SORT outputs; ``alive``, every frame of a track's life); then starts the tracks born this frame, each
-with its colour reference from its first detection's box in this frame.
+associated with them, as SORT outputs; ``alive``, every frame of a track's life), each with its box by
+``box`` (``estimate``: the filter's; ``detection``: in a frame with an associated detection, that detection's, as
+SORT's output sits on its detections; ``average``: the two's mean there); then starts the tracks born this frame,
+each with its colour reference from its first detection's box in this frame.
 """
 
 from collections import Counter
@@ -44,6 +46,14 @@ OUTPUTS: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
     "detected": lambda detected, supported: detected,
     "supported": lambda detected, supported: supported,
     "alive": lambda detected, supported: np.ones_like(supported),
+}
+# Which box a shown track outputs, from the filter's estimates (K, 4), the detections associated with them (K, 4:
+# NaN where none) and whether one is: the estimate, or where a detection is associated, the detection or the mean.
+BOXES: dict[str, Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]] = {
+    "estimate": lambda estimates, associated, detected: estimates,
+    "detection": lambda estimates, associated, detected: np.where(detected[:, None], associated, estimates),
+    "average": lambda estimates, associated, detected: np.where(detected[:, None], (estimates + associated) / 2,
+                                                                 estimates),
 }
 Frame = tuple[int, np.ndarray, np.ndarray]  # MOT frame number, ids (K,), boxes (K, 4)
 
@@ -71,6 +81,7 @@ class ParticleTracker:
     association_iou: float = 0.3  # not stated: our choice, SORT's gate
     min_score: float = -np.inf  # detections below are ignored
     output: str = "supported"
+    box: str = "estimate"  # the box output (BOXES)
     stopwatch: Stopwatch = field(default_factory=Stopwatch, init=False)
     born: int = field(default=0, init=False)  # tracks started
     counts: Counter = field(default_factory=Counter, init=False)  # where the tracks' frames went (EVENTS)
@@ -78,6 +89,8 @@ class ParticleTracker:
     def __post_init__(self):
         if self.output not in OUTPUTS:
             raise ValueError(f"unknown output {self.output!r}; choose one of {sorted(OUTPUTS)}")
+        if self.box not in BOXES:
+            raise ValueError(f"unknown box {self.box!r}; choose one of {sorted(BOXES)}")
 
     def track(self, sequence, frames, rng: np.random.Generator) -> Iterator[Frame]:
         detections = detection_boxes(sequence.detections, self.min_score)
@@ -107,7 +120,9 @@ class ParticleTracker:
                                         "shown_frames": int(shown.sum()),
                                         "died_unsupported": int((dead & causes["unsupported"]).sum()),
                                         "died_outside": int((dead & ~causes["unsupported"]).sum())})
-                    out_ids, out_boxes = ids[shown], boxes[shown]
+                    associated = np.full_like(boxes, np.nan)
+                    associated[detected] = found[assigned[detected]]
+                    out_ids, out_boxes = ids[shown], BOXES[self.box](boxes, associated, detected)[shown]
                     for index in np.flatnonzero(dead)[::-1]:
                         self.method.remove(state, int(index))
                     ids, boxes, unsupported = ids[~dead], boxes[~dead], unsupported[~dead]

@@ -57,6 +57,16 @@ def _set(params: dict[str, Any], name: str, value: Any) -> None:
     params[key] = value
 
 
+def _get(params: dict[str, Any], name: str, default: Any = None) -> Any:
+    """``params.get(name, default)``, a dotted ``name`` (``deaths.seconds``) reading a key inside a block."""
+    *blocks, key = name.split(".")
+    for block in blocks:
+        params = params.get(block)
+        if not isinstance(params, dict):
+            return default
+    return params.get(key, default)
+
+
 def _run_key(task: str, model: dict, method: dict, base_seed: int, code: str) -> str:
     """Hash of everything that can change a run's numbers (not its repetition): the config and ``code``, the
     digest of the code the run executes (:func:`~replication.runner.provenance.method_code_digest`)."""
@@ -158,7 +168,7 @@ def planned(experiment: dict) -> Iterator[tuple[str, Condition, Condition, dict,
                 run_model["observation"] = {**model.get("observation", {}), **observation}
             for (on_model, name, _), value in zip(sweeps, values):
                 _set(run_model if on_model else run_params, name, value)
-            if any(run_model.get(k, run_params.get(k)) not in allowed for k, allowed in only.items()):
+            if any(_get(run_model, k, _get(run_params, k)) not in allowed for k, allowed in only.items()):
                 continue
             condition = Condition.of((name, value) for (_, name, _), value in zip(sweeps, values))
             data_condition = Condition.of((name, value) for (on_model, name, _), value in zip(sweeps, values)

@@ -12,7 +12,8 @@ The record holds the MOT metrics of its track table against the ground truth of 
 frames (CLEAR MOT and IDF1 at IoU 0.5, flag-0 boxes ignored: :mod:`replication.metrics.mot`;
 HOTA by TrackEval: :mod:`replication.metrics.hota`),
 bis_pf's error (the distance from a person's box centre to the centre of the track matched
-to it, in px, averaged over every match), tracks started per person, where a particle tracker's
+to it, in px, averaged over every match), where the false positives and misses come from
+(:func:`~replication.metrics.mot_errors.error_sources`), tracks started per person, where a particle tracker's
 frames went (:func:`breakdown`), how close its boxes are to the detections it was given (the mean
 IoU of each output box with its frame's nearest detection: 1 for the detections themselves), the
 time per frame (frame decoding excluded) and the track table itself (``tracks``: rows frame, id,
@@ -27,8 +28,9 @@ import pandas as pd
 from replication.filters.registry import build_filter
 from replication.filters.joint import JointFilter
 from replication.filters.open_tracker import DetectionTracker, ParticleTracker
-from replication.filters.track_management import Deleter, Initiator
+from replication.filters.track_management import Deleter, Initiator, in_frames
 from replication.metrics.hota import hota
+from replication.metrics.mot_errors import error_sources
 from replication.metrics.mot import (
     BOX, clear_mot_matches, detection_overlap, drop_ignored, matched_centre_error, mot_metrics,
 )
@@ -42,8 +44,8 @@ from replication.vision.colour import ColourLikelihood
 from replication.vision.histogram import ColourHistogram
 
 SCENE_KEYS = {"kind", "name", "root", "first", "last", "stand_in"}
-MODEL_KEYS = {"scene", "scene_spec", "motion", "observation", "births", "deaths", "association", "proposal",
-              "detection_term", "min_iou"}
+MODEL_KEYS = {"scene", "scene_spec", "motion", "size_steps", "observation", "births", "deaths", "association",
+              "proposal", "detection_term", "min_iou"}
 TRACK_COLUMNS = ["frame", "id", *BOX]  # a row of the record's ``tracks``
 
 
@@ -60,8 +62,9 @@ def frames_of(spec: dict, sequence) -> range:
     return range(first, last + 1)
 
 
-def _tracker(run_model: dict, method, new_model) -> ParticleTracker | DetectionTracker:
-    """The open-set tracker of a configured method: a joint filter gets the births, deaths and association."""
+def _tracker(run_model: dict, method, new_model, frame_rate: float) -> ParticleTracker | DetectionTracker:
+    """The open-set tracker of a configured method: a joint filter gets the births, deaths and association,
+    patience given in seconds converted at the sequence's ``frame_rate``."""
     if isinstance(method, DetectionTracker):
         return method
     if not isinstance(method, JointFilter):
@@ -69,10 +72,24 @@ def _tracker(run_model: dict, method, new_model) -> ParticleTracker | DetectionT
                          "(mipf, bis, mfmc, dmot, mcmc) or a detection tracker (sort, detections_only)")
     association = run_model.get("association", {})
     return ParticleTracker(
-        method, new_model, Initiator(**run_model.get("births", {})), Deleter(**run_model.get("deaths", {})),
+        method, new_model, Initiator(**in_frames(run_model.get("births", {}), frame_rate)),
+        Deleter(**in_frames(run_model.get("deaths", {}), frame_rate)),
         association_iou=association.get("min_iou", 0.3), min_score=association.get("min_score", -np.inf),
-        output=association.get("output", "supported"),
+        output=association.get("output", "supported"), box=association.get("box", "estimate"),
     )
+
+
+def box_motion(run_model: dict) -> dict:
+    """The random walk of a person's box: ``motion`` with its ``step_sd`` the centre's steps (cx, cy) and
+    ``size_steps`` the size's (w, h), px per frame.  The size steps are the multi-target pipeline's own key,
+    so that a reading of them leaves the balls' experiments alone (``motion.step_sd`` is a key they share in
+    the readings multiverse)."""
+    motion = dict(run_model.get("motion", {}))
+    centre = list(motion.get("step_sd", ()))
+    if len(centre) != 2 or "size_steps" not in run_model:
+        raise ValueError("a mot experiment gives motion.step_sd as the centre's steps [cx, cy] and size_steps as "
+                         f"the size's [w, h]; got step_sd {centre} and size_steps {run_model.get('size_steps')}")
+    return {**motion, "step_sd": [*centre, *run_model["size_steps"]]}
 
 
 def _model_builder(run_model: dict, rng: np.random.Generator, work: Work):
@@ -84,7 +101,7 @@ def _model_builder(run_model: dict, rng: np.random.Generator, work: Work):
         histogram = ColourHistogram(**histogram_args(observation, box[2:4], rng))
         likelihood = ColourLikelihood.from_frame(image, box, histogram, observation.get("sigma", 0.1))
         return Counted(BoostedBoxModel(box, likelihood, cache=cache, detection_term=run_model.get("detection_term"),
-                                       **run_model.get("motion", {}), **run_model.get("proposal", {})), work)
+                                       **box_motion(run_model), **run_model.get("proposal", {})), work)
 
     return new_model
 
@@ -96,12 +113,13 @@ def check(model: dict, method: dict) -> None:
     unknown = (set(spec) - SCENE_KEYS) | (set(model) - MODEL_KEYS)
     if unknown:
         raise ValueError(f"unknown keys {sorted(unknown)}")
-    frames_of(spec, sequence_of(spec["name"], spec.get("root", MOT_ROOT)))
+    sequence = sequence_of(spec["name"], spec.get("root", MOT_ROOT))
+    frames_of(spec, sequence)
     ColourHistogram(**histogram_args(model.get("observation", {}), (8, 8), np.random.default_rng(0)))
-    BoostedBoxModel(np.ones(4), None, detection_term=model.get("detection_term"), **model.get("motion", {}),
+    BoostedBoxModel(np.ones(4), None, detection_term=model.get("detection_term"), **box_motion(model),
                     **model.get("proposal", {}))
     method_object = build_filter("check", method)
-    _tracker(model, method_object, None)
+    _tracker(model, method_object, None, sequence.frame_rate)
 
 
 def breakdown(counts: dict, alpha: float) -> dict:
@@ -124,7 +142,7 @@ def run(run: Run) -> dict:
     frames = frames_of(spec, sequence)
     work = Work()  # every target's model counts into it (replication.smc.work); none for a detection reference
     new_model = _model_builder(run.model, run.rng("pattern"), work)
-    tracker = _tracker(run.model, build_filter(run.method, run.method_params), new_model)
+    tracker = _tracker(run.model, build_filter(run.method, run.method_params), new_model, sequence.frame_rate)
     rows = [
         (frame, int(i), *box)
         for frame, ids, boxes in tracker.track(sequence, frames, run.rng("filter"))
@@ -134,15 +152,17 @@ def run(run: Run) -> dict:
     truth, ignored = (table[table["frame"].isin(frames)] for table in (sequence.truth, sequence.ignored))
     min_iou = run.model.get("min_iou", 0.5)
     kept = drop_ignored(tracks, truth, ignored, min_iou)  # once, for every metric below
+    matches = clear_mot_matches(truth, kept, min_iou=min_iou)
+    given = sequence.detections
+    used = given[given["frame"].isin(frames) & (given["score"] >= run.model.get("association", {}).get("min_score", -np.inf))]
     scores = {
         **mot_metrics(truth, kept, min_iou=min_iou),
         "ignored_hypotheses": len(tracks) - len(kept),
         **hota(truth, kept, min_iou=min_iou),
-        "mean_error_per_target": matched_centre_error(truth, kept, clear_mot_matches(truth, kept, min_iou=min_iou)),
+        "mean_error_per_target": matched_centre_error(truth, kept, matches),
+        **error_sources(truth, kept, used, matches, min_iou=min_iou),
     }
     people = int(truth["id"].nunique())
-    given = sequence.detections
-    used = given[given["frame"].isin(frames) & (given["score"] >= run.model.get("association", {}).get("min_score", -np.inf))]
     return {
         "sequence": sequence.name,
         "first_frame": frames.start,
