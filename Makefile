@@ -58,7 +58,7 @@ browser:
 		|| echo "chromium not installed: the headless-browser report test will be skipped"
 
 test: setup browser
-	$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadgroup
+	$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadgroup --durations=25
 
 test-fast: setup
 	$(BIN)/python -m pytest -m "not slow and not e2e" -n $(JOBS) --dist loadgroup
