@@ -93,6 +93,7 @@ def _drawn(tmp_path: Path) -> Drawn:
                {"experiment": "exp", "method": "C", "cpu_minutes": 0.5, "parts": {}}]  # C: made by older code
     (folder / "status.json").write_text(json.dumps({"runs": 40, "megabytes": 11.8, "experiments": {
         "exp": {"runs": 40, "minutes": 1.25, "cpu_minutes": 2.5, "stale": 0, "universes": 0, "designed": 0,
+                "thread_cpu_minutes": 2.25, "load_1m": [1.5, 2.25], "reference_ms": 4.5,
                 "before": {"minutes": 2.0, "cpu_minutes": 4.0, "commits": ["abc1234"], "written": "2026-11-01"}},
         "exp_readings": {"runs": 300, "minutes": None, "cpu_minutes": 9.5, "stale": 0, "universes": 6,
                          "designed": 17, "before": None}},
@@ -119,8 +120,9 @@ def test_a_template_renders_claims_rows_and_tables_from_the_drawn_pages(tmp_path
     assert ("| `p.b`: C beats D | \u201cC is better than D\u201d (Table 2) | **not reproduced** | C N=1 | 0.5 [0.25, 0.75] "
             "(95% CI) | 10 | one reading |") in tables
     assert "| 1 | A | N=1 | rmse | 4.2 | 4.25 | 20 | reproduced |" in tables
-    assert "| `exp` | 40 |  | 1.25 | 2.5 | 2 min, 4 CPU-min (abc1234) |" in tables  # recorded again: what it took
-    assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |  |" in tables  # a multiverse the record holds in part
+    # recorded again: what it took, with its threads' CPU, the load (median / max) and the machine's speed
+    assert "| `exp` | 40 |  | 1.25 | 2.5 | 2.25 | 1.5 / 2.25 | 4.5 | 2 min, 4 CPU-min (abc1234) |" in tables
+    assert "| `exp_readings` | 300 | 6 of 17 |  | 9.5 |  |  |  |  |" in tables  # a multiverse the record holds in part
 
 
 def test_the_readme_part_gives_the_record_size_and_what_each_part_took(tmp_path):
