@@ -41,10 +41,8 @@ class LeaveOneOut(TableKind):
     def build(self, records: pd.DataFrame) -> Table:
         spec, over = self.spec, PREFIX + self.spec.over
         rule = Rule(spec.objective, spec.method, spec.constraint, spec.over)
-        names = tuple(dict.fromkeys([spec.objective, *([spec.constraint["metric"]] if spec.constraint else []),
-                                     *spec.metrics]))
-        summaries = {metric: summarise(records, metric) for metric in names}
-        first = summaries[names[0]]
+        summaries = {metric: summarise(records, metric) for metric in rule.metrics(spec.metrics)}
+        first = summaries[spec.objective]
         settings = rule.settings(first)
         sequences = list(dict.fromkeys(first[over]))
         rows, picks = [], {}

@@ -21,12 +21,15 @@ class Summary(TableKind):
         metrics: tuple[str, ...]
 
     def build(self, records: pd.DataFrame) -> Table:
-        columns = {metric: summarise(records, metric) for metric in self.spec.metrics}
-        first = columns[self.spec.metrics[0]]
+        return Table(self.frame({metric: summarise(records, metric) for metric in self.spec.metrics}))
+
+    def frame(self, columns: dict[str, pd.DataFrame]) -> pd.DataFrame:
+        """The table's rows from each metric's :func:`summarise` (``columns``, in the order shown)."""
+        first = next(iter(columns.values()))
         table = pd.DataFrame({"method": [self.label(m) for m in first["method"]],
                               "condition": [c or "-" for c in first["condition"]], "runs": first["runs"]})
         for metric, summary in columns.items():
             table[metric] = [Estimate(*values, "") for values in
                              zip(summary["mean"], summary["ci_low"], summary["ci_high"], summary["runs"])]
-        return Table(table)
+        return table
 

@@ -10,7 +10,7 @@ judge: the pick is then frozen in the experiment that is judged, and this table 
 objective moves with the setting.
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import pandas as pd
@@ -52,6 +52,11 @@ class Rule:
             return None
         return str(score.idxmin() if quantity(self.objective).lower_is_better else score.idxmax())
 
+    def metrics(self, shown: tuple[str, ...]) -> tuple[str, ...]:
+        """The metrics the rule reads (its objective, its constraint's) and then ``shown``, each once."""
+        return tuple(dict.fromkeys([self.objective, *([self.constraint["metric"]] if self.constraint else []),
+                                    *shown]))
+
     def said(self, label: str) -> str:
         """The rule in words, the tuned method shown as ``label``."""
         words = f"the best mean {quantity(self.objective).label or self.objective} of {label}"
@@ -86,10 +91,9 @@ class Tuning(Summary):
     def build(self, records: pd.DataFrame) -> Table:
         spec = self.spec
         rule = Rule(spec.objective, spec.method, spec.constraint, spec.over)
-        metrics = tuple(dict.fromkeys([spec.objective, *([spec.constraint["metric"]] if spec.constraint else []),
-                                       *spec.metrics]))
+        metrics = rule.metrics(spec.metrics)
         summaries = {metric: summarise(records, metric) for metric in metrics}
-        table = Summary(replace(spec, metrics=metrics), self.experiment, self.published).build(records).frame
+        table = self.frame(summaries)
         settings = rule.settings(summaries[metrics[0]])
         picked = rule.pick(summaries, settings)
         means = pd.Series([e.value for e in table[spec.objective]], index=table.index)
