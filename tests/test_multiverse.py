@@ -44,6 +44,41 @@ def test_designs_start_from_the_default_and_cover_what_they_say():
             design(choices, bad, seed=1)
 
 
+def test_a_choice_added_outside_a_sobol_designs_over_leaves_its_points_and_a_list_is_the_union():
+    """Adding a choice to a paper's readings must not redraw the universes already run: a Sobol design ``over``
+    the old choices keeps their points (the new choice at its default there), and a list of designs adds the
+    new choice's own universes beside them."""
+    choices = choices_of(TWO_BY_THREE)
+    before = design(choices, {"sobol": 8}, seed=1)
+    grown = choices_of({**TWO_BY_THREE, "c": {"alternatives": {"c0": {"why": "x", "set": {"r": 0}},
+                                                                "c1": {"why": "y", "set": {"r": 1}}}}})
+    kept = design(grown, {"sobol": 8, "over": ["a", "b"]}, seed=1)
+    assert [u.name for u in kept] == [u.name for u in before]  # the same universes, named alike
+    assert all(dict(u.picks)["c"] == "c0" for u in kept)
+    union = design(grown, [{"sobol": 8, "over": ["a", "b"]}, {"one_at_a_time": ["c"]}], seed=1)
+    assert [u.name for u in union] == [u.name for u in before] + ["c=c1"]  # the default once
+    for bad in ({"sobol": 8, "over": ["d"]}, {"sobol": 8, "over": []}, {"sobol": 8, "of": ["a"]}):
+        with pytest.raises(ConfigError, match="design"):
+            design(grown, bad, seed=1)
+
+
+def test_a_choices_default_never_overrides_another_choices_reading_of_the_same_path():
+    """Patience in frames (one choice) or in seconds (another): the frames' reading sets seconds to None, and the
+    seconds' default, whatever the choices' order, does not set it back."""
+    from replication.runner.multiverse import Universe, universe_values
+
+    spec = {"seconds": {"alternatives": {"s14": {"why": "x", "set": {"d.seconds": 1.4}},
+                                         "s07": {"why": "y", "set": {"d.seconds": 0.7}}}},
+            "frames": {"alternatives": {"given": {"why": "x", "set": {"d.frames": None}},
+                                        "f10": {"why": "y", "set": {"d.frames": 10, "d.seconds": None}}}}}
+    for order in (list(spec), list(reversed(spec))):
+        choices = choices_of({name: spec[name] for name in order})
+        picked = [c.alternatives[1] if c.name == "frames" else c.default for c in choices]
+        assert universe_values(choices, Universe.of(choices, picked)) == {"d.seconds": None, "d.frames": 10}
+        picked = [c.alternatives[1] if c.name == "seconds" else c.default for c in choices]
+        assert universe_values(choices, Universe.of(choices, picked)) == {"d.seconds": 0.7, "d.frames": None}
+
+
 def test_a_choice_needs_two_alternatives_each_with_its_why():
     with pytest.raises(ConfigError, match="at least two"):
         choices_of({"a": {"alternatives": {"only": {"why": "x", "set": {"p": 0}}}}})

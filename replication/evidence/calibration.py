@@ -39,6 +39,7 @@ not best at 5 %; the paper's size taken as exact, at the size test's level), so
 the simulation is seen to catch a bad rule.
 """
 
+import itertools
 import math
 import zlib
 from dataclasses import dataclass
@@ -58,6 +59,7 @@ from replication.evidence.trends import dominance, log_log_slope
 from replication.evidence.quantities import Quantity
 from replication.evidence.verdict import OUTCOMES, Outcome, cell_test, decide, judge_band, judge_value, stability_bands
 from replication.evidence.settings import INFERENCE
+from replication.evidence.tables.non_inferiority import at_most, no_worse
 
 REPLICATIONS = 10_000  # make calibrate: a Monte Carlo standard error of at most 0.005 on every row
 QUICK_REPLICATIONS = 800  # the test suite's version
@@ -71,6 +73,7 @@ LOGNORMAL_SIGMA = 0.5
 RUNS = (5, 6, 10, 20, 30, 50, 100)
 CHAINS = (6, 9)  # checks in a reading: ism_pf.accuracy (2 pairs x 3 scenes), gps_qmcpf.rmse (3 x 3)
 EFFECTS = (0.5, 1.0)
+BAR_RULES = ("no worse", "at most")  # issue 61's bar, at bis_pf_pets' 10 runs (5 at the quick scale)
 PAPER_RUNS = (10, 20, 100)  # the papers' counts behind a size: bis_pf; fusion_pf's fewest, the helicopter; ism_pf
 COLUMNS = ["test", "runs", "checks", "distribution", "truth", "guards", "effect", "paper_runs", "rate", "mc_se",
            "wrong_rate", "power", "holds", "control", "criterion", "replications"]
@@ -206,6 +209,32 @@ def threshold_case(runs, distribution, truth, guards, effect) -> Case:
         return _reading(tested.p_above[..., None], tested.p_below[..., None])
 
     return Case("threshold (median)", runs, 1, distribution, truth, guards, effect, draw)
+
+
+def bar_case(runs, distribution, truth, effect, rule: str, control=False, mirrored=False) -> Case:
+    """One test of issue 61's bar (evidence/tables/non_inferiority.py) against a deterministic reference:
+    ``rule`` "no worse" (a score at least the reference's less a margin) or "at most" (a count at most a
+    bound), the median run ``effect`` sd on the clearing side of the bar (null: on it).  ``control``: the rule
+    before, the one-sample t on the mean (its mean on the bar under the null), which a skewed spread misleads;
+    ``mirrored``: the noise's skew turned the other way (a score's tail toward low values)."""
+    margin, bound = 0.5, 1.5
+
+    def draw(rng, reps):
+        sign = -1.0 if mirrored else 1.0
+        centred = sign * noise(distribution, rng, (reps, runs))  # mean 0; the control's null puts the mean on the bar
+        centred = centred if control else centred - sign * _median(distribution)  # median 0: the rule's null
+        if rule == "no worse":
+            ours, reference = centred - margin + effect, np.zeros((reps, runs))
+            cleared = (mean_test(ours - reference + margin).p_above if control
+                       else no_worse(ours, reference, False, margin)) < INFERENCE.alpha
+        else:
+            ours = centred + bound - effect
+            cleared = (mean_test(ours, bound).high <= bound) if control else at_most(ours, bound) < INFERENCE.alpha
+        return np.where(cleared, REPRODUCED, NOT_REPRODUCED)
+
+    name = f"bar: {rule}" + (", the t on the mean (rule before)" if control else " (median run, sign test)")
+    return Case(name + (", skew mirrored" if mirrored else ""), runs, 1, distribution, truth, "reproduced", effect,
+                draw, control)
 
 
 def _lognormal_moments() -> tuple[float, float]:
@@ -417,6 +446,10 @@ def cases(runs=RUNS, distributions=DISTRIBUTIONS) -> list[Case]:
                   rate_case(n, "null", "not reproduced", 0.8), rate_case(n, "effect", "reproduced", 0.8)]
     for n in (5, 10):
         found += [band_case(n, "null", "not reproduced", 0.15), band_case(n, "null", "reproduced", 0.16)]
+        for rule, d, mirrored in itertools.product(BAR_RULES, distributions, (False, True)):
+            found += [bar_case(n, d, "null", 0.0, rule, mirrored=mirrored),
+                      bar_case(n, d, "null", 0.0, rule, control=True, mirrored=mirrored)]
+            found += [bar_case(n, d, "effect", e, rule, mirrored=mirrored) for e in EFFECTS]
     for d in distributions:
         found += [best_case(d, "null", "reproduced", 0.0), best_case(d, "null", "not reproduced", 0.0),
                   best_case(d, "effect", "reproduced", 1.0)]

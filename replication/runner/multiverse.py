@@ -8,8 +8,9 @@ A *universe* picks one alternative per choice; the *design* says which
 universes are run: ``full`` (every combination), ``one_at_a_time`` (the
 default, then each other alternative alone) or ``{sobol: n}`` (n points of a
 scrambled Sobol sequence over the choices, for a product too large to run);
-``{full: [a, b]}`` and ``{one_at_a_time: [a, b]}`` vary only the choices
-named (a smaller design for the quick scale).  Like every setting, the design,
+``{full: [a, b]}``, ``{one_at_a_time: [a, b]}`` and ``{sobol: n, over: [a, b]}`` vary only the
+choices named (a smaller design for the quick scale; a Sobol design whose points stay where they were
+when choices are added), and a list of designs runs the union of their universes.  Like every setting, the design,
 the run count and the experiments may differ by scale (``{paper: .., quick: ..}``).
 
 Each universe's runs are the base experiments' runs with the alternatives'
@@ -127,24 +128,32 @@ def choices_of(spec: dict) -> tuple[Choice, ...]:
 def design(choices: tuple[Choice, ...], spec: Any, seed: int) -> tuple[Universe, ...]:
     """The universes to run, the default first (see the module's docstring for the designs).
 
-    ``{full: [a, b]}`` or ``{one_at_a_time: [a, b]}`` vary only the choices named, the others staying
-    at their default (a smaller design for a quick look)."""
+    ``{full: [a, b]}``, ``{one_at_a_time: [a, b]}`` or ``{sobol: n, over: [a, b]}`` vary only the choices
+    named, the others staying at their default; a list of designs gives the union of their universes."""
+    picks = [p for one in (spec if isinstance(spec, list) and spec else [spec]) for p in _picks(choices, one, seed)]
+    picks = list(dict.fromkeys(picks))  # the default once, a Sobol point drawn twice once
+    return tuple(Universe.of(choices, [c.alternatives[i] for c, i in zip(choices, p)]) for p in picks)
+
+
+def _picks(choices: tuple[Choice, ...], spec: Any, seed: int) -> list[tuple[int, ...]]:
+    """One design's universes as the index of each choice's alternative, the default first."""
     kind, varied, n = _design_of(spec, choices)
     sizes = [len(c.alternatives) if c.name in varied else 1 for c in choices]
     default = tuple(0 for _ in sizes)
     if kind == "full":
-        picks = list(itertools.product(*(range(n) for n in sizes)))
-    elif kind == "one_at_a_time":
-        picks = [default] + [tuple(i if j == k else 0 for j in range(len(sizes)))
-                             for k, n in enumerate(sizes) for i in range(1, n)]
-    elif kind == "sobol":
-        points = qmc.Sobol(len(sizes), scramble=True, seed=np.random.default_rng(seed)).random(n)
-        picks = [default] + [tuple(int(i) for i in row) for row in (points * np.array(sizes)).astype(int)]
-    else:
-        raise ConfigError(f"experiment.multiverse.design must be full, one_at_a_time, {{sobol: n}} (n a power of "
-                          f"two: Sobol points balance only then) or {{full|one_at_a_time: [choices]}}; got {spec!r}")
-    picks = list(dict.fromkeys(picks))  # the default once, a Sobol point drawn twice once
-    return tuple(Universe.of(choices, [c.alternatives[i] for c, i in zip(choices, p)]) for p in picks)
+        return list(itertools.product(*(range(n) for n in sizes)))
+    if kind == "one_at_a_time":
+        return [default] + [tuple(i if j == k else 0 for j in range(len(sizes)))
+                            for k, n in enumerate(sizes) for i in range(1, n)]
+    if kind == "sobol":  # one dimension per varied choice, so that a choice added outside ``over`` moves no point
+        dims = [k for k, c in enumerate(choices) if c.name in varied]
+        points = qmc.Sobol(len(dims), scramble=True, seed=np.random.default_rng(seed)).random(n)
+        cells = (points * np.array([sizes[k] for k in dims])).astype(int)
+        return [default] + [tuple(int(row[dims.index(k)]) if k in dims else 0 for k in range(len(sizes)))
+                            for row in cells]
+    raise ConfigError(f"experiment.multiverse.design must be full, one_at_a_time, {{sobol: n}} (n a power of "
+                      f"two: Sobol points balance only then), {{full|one_at_a_time: [choices]}}, "
+                      f"{{sobol: n, over: [choices]}} or a list of these; got {spec!r}")
 
 
 def _design_of(spec: Any, choices: tuple[Choice, ...]) -> tuple[str | None, list[str], int]:
@@ -153,11 +162,13 @@ def _design_of(spec: Any, choices: tuple[Choice, ...]) -> tuple[str | None, list
     names = [c.name for c in choices]
     if isinstance(spec, str):
         return spec, names, 0
-    if not isinstance(spec, dict) or len(spec) != 1:
+    if not isinstance(spec, dict) or not spec:
         return None, names, 0
-    (kind, value), = spec.items()
-    if kind == "sobol":
-        return (kind if _power_of_two(value) else None), names, value
+    if "sobol" in spec and set(spec) <= {"sobol", "over"}:
+        over = spec.get("over", names)
+        known = isinstance(over, list) and over and set(over) <= set(names)
+        return ("sobol" if _power_of_two(spec["sobol"]) and known else None), list(over) if known else names, spec["sobol"]
+    (kind, value), = spec.items() if len(spec) == 1 else ((None, None),)
     if kind in ("full", "one_at_a_time") and isinstance(value, list) and value and set(value) <= set(names):
         return kind, value, 0
     return None, names, 0
@@ -219,9 +230,7 @@ def load(cfg: DictConfig) -> Multiverse:
     top = {k: v for k, v in OmegaConf.to_container(cfg, resolve=True).items() if k != "experiment"}
     runs, configs, skipped = {}, {}, {}
     for universe in universes:
-        picked = dict(universe.picks)
-        values = {path: value for c in choices for a in c.alternatives if a.name == picked[c.name]
-                  for path, value in a.values.items()}
+        values = universe_values(choices, universe)
         for name, base in bases.items():
             experiment, _ = apply(base, values)
             if not universe.is_default:  # the default universe is the base experiments at their own run count
@@ -234,6 +243,15 @@ def load(cfg: DictConfig) -> Multiverse:
             skipped.update(dict.fromkeys(missing))
             configs[universe.name, name] = experiment_at_scale(derived)
     return Multiverse(exp.name, exp.paper, experiments, choices, universes, runs, configs, tuple(skipped))
+
+
+def universe_values(choices: tuple[Choice, ...], universe: Universe) -> dict[str, Any]:
+    """The config values ``universe`` sets: every picked alternative's, a choice's default never overriding
+    another choice's reading of the same path (two readings of one setting: patience in frames or in seconds)."""
+    picked = dict(universe.picks)
+    chosen = [(c, a) for c in choices for a in c.alternatives if a.name == picked[c.name]]
+    return {path: value for c, a in sorted(chosen, key=lambda ca: ca[1] is not ca[0].default)
+            for path, value in a.values.items()}
 
 
 def named_experiments(multiverse: dict) -> list[str]:
