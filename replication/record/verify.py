@@ -525,7 +525,8 @@ def rejudged(folder: Path, verification: Verification, n_jobs: int,
              verdicts: Callable[[Path, Path, list[str], int], list[str]], multiverses: bool = True) -> list[str]:
     """The verdicts that change when the runs that are not identical replace the recorded ones, in every
     experiment (and, with ``multiverses``, every multiverse) holding one; none to re-judge where every run
-    is identical (the same numbers give the same verdicts)."""
+    is identical (the same numbers give the same verdicts) or every one that is not sits in a multiverse left
+    out."""
     differing = [r for r in verification.runs if r.grade is not Grade.IDENTICAL]
     if not differing:
         print("verdicts: every re-computed run is identical, so are the verdicts")
@@ -534,6 +535,10 @@ def rejudged(folder: Path, verification: Verification, n_jobs: int,
     with tempfile.TemporaryDirectory(prefix="verify-record-") as scratch:
         copy = Path(scratch) / "record"
         names = [name for name in substituted(folder, differing, copy) if multiverses or not universes[name]]
+        if not names:  # never pass an empty list on: verdicts() reads it as every experiment of the record
+            print(f"verdicts: the {len(differing)} runs that are not identical are all in multiverses, not "
+                  f"re-judged here")
+            return []
         print(f"verdicts: re-judging {len(names)} experiments and multiverses with the {len(differing)} runs that "
               f"are not identical in place of the recorded ({', '.join(names)})", flush=True)
         return verdicts(folder, copy, names, n_jobs)
