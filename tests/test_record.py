@@ -310,11 +310,13 @@ def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically
     assert found.failing == [], "\n".join(r.line() for r in found.failing)
     # elsewhere, the runs that are not identical in place of the recorded ones move no verdict of an
     # experiment (make verify judges the multiverses' too: minutes more)
-    def judged(before, after, names, n_jobs):  # an empty list would draw every experiment's pages twice
-        assert names, "rejudged asked for the verdicts of no experiment, which reads as all of them"
+    def judged(before, after, names, n_jobs):
+        assert names, "rejudged asked for the verdicts of no experiment"
         return verdicts(before, after, names, n_jobs)
 
     assert rejudged(folder, found, 2, judged, multiverses=False) == []
+    with pytest.raises(ValueError, match="name the experiments"):  # never read as the whole record, drawn twice
+        verdicts(folder, folder, [], 2)
 
 
 def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):

@@ -535,7 +535,7 @@ def rejudged(folder: Path, verification: Verification, n_jobs: int,
     with tempfile.TemporaryDirectory(prefix="verify-record-") as scratch:
         copy = Path(scratch) / "record"
         names = [name for name in substituted(folder, differing, copy) if multiverses or not universes[name]]
-        if not names:  # never pass an empty list on: verdicts() reads it as every experiment of the record
+        if not names:  # nothing to judge (verdicts() refuses an empty list)
             print(f"verdicts: the {len(differing)} runs that are not identical are all in multiverses, not "
                   f"re-judged here")
             return []

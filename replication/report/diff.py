@@ -126,6 +126,8 @@ def verdicts(before: Path, after: Path, experiments: list[str], n_jobs: int = 2)
     """Each claim and published cell whose verdict differs between two records judged on their entries
     ``experiments`` (each drawn as ``report source=record`` draws it), a line each; printed after the counts,
     with how many estimates moved though their verdict held."""
+    if not experiments:  # drawn() reads no experiments as the whole record: never what a caller naming them means
+        raise ValueError("verdicts: name the experiments to judge; none were named")
     with ExitStack() as stack:
         folders = [drawn(str(source), Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="verdicts-"))),
                          tuple(experiments), n_jobs) for source in (before, after)]
