@@ -6,6 +6,7 @@ import gc
 import signal
 import subprocess
 import sys
+import time
 
 import pytest
 from conftest import PROJECT_ROOT
@@ -138,3 +139,26 @@ def test_an_interrupted_runner_stops_its_children_and_exits_without_a_last_colle
     done = subprocess.run([sys.executable, "-c", script], cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=60)
     assert done.stdout.split("\n")[:2] == [f"child: -{signal.SIGTERM.value}", "frozen: True"], done
     assert gc.get_freeze_count() == 0  # the suite's own process is left as it is
+
+
+def test_a_process_tree_taken_before_its_root_ends_is_ended_whole():
+    """What a local ray cluster's shutdown relies on: the tree of the processes it started, taken while its
+    raylet lives, holds the agents the raylet started; once the raylet has gone they are orphans no walk from
+    it finds, and :func:`end_within` kills each one still running after its grace, SIGTERM ignored or not."""
+    from replication.runner import lifeline
+
+    root = subprocess.Popen(["sh", "-c", "(trap '' TERM; sleep 120) & (trap '' TERM; sleep 120) & wait"])
+    deadline = time.monotonic() + 30
+    while len(tree := lifeline.descendants({root.pid})) < 5 and time.monotonic() < deadline:  # sh, 2 x (sh, sleep)
+        time.sleep(0.05)
+    assert len(tree) >= 3 and root.pid in tree, tree
+    root.kill()
+    root.wait()
+    orphans = tree - {root.pid}
+    assert lifeline.descendants({root.pid}) == set() and lifeline.descendants(orphans) >= orphans
+    started = time.monotonic()
+    lifeline.end_within(tree, 0.5)
+    assert 0.5 <= time.monotonic() - started < 10
+    while lifeline.descendants(orphans) and time.monotonic() < deadline:  # SIGKILLed: gone once the kernel reaps
+        time.sleep(0.05)
+    assert lifeline.descendants(orphans) == set()

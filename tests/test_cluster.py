@@ -1,6 +1,7 @@
 """Beyond one machine: the dask and ray backends (clusters started from their command lines on the loopback,
-as on real machines) and the threading backend store the same records as loky; a local cluster listens on the loopback alone;
-one SIGTERM stops every local backend and everything it started."""
+as on real machines) and the threading backend store the same records as loky, a multiverse's too; a run lost
+with a killed worker is computed again, and nothing else; a local cluster listens on the loopback alone; one
+SIGTERM stops every local backend and everything it started."""
 
 import ipaddress
 import os
@@ -12,23 +13,23 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
 import pytest
 from conftest import PROJECT_ROOT
-from test_reliability import INTERRUPTED, NEEDS_PROC, command, descendants, processes, still_running
+from test_reliability import (
+    INTERRUPTED, NEEDS_PROC, command, descendants, deterministic_columns, processes, still_running, stored_table,
+)
 
 from replication.runner.config import expand
 from replication.runner.backends import CLUSTER_PACKAGES
-from replication.runner.execute import TIMING_COLUMNS, execute
+from replication.runner.execute import execute
 from replication.runner.store import Store
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
-
-
-def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
-    return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore").sort_values("run_id").reset_index(drop=True)
 
 
 # clusters and subprocesses: make test-fast leaves them out; one xdist worker runs them all (make test's
@@ -36,10 +37,10 @@ def deterministic_columns(frame: pd.DataFrame) -> pd.DataFrame:
 pytestmark = [pytest.mark.e2e, pytest.mark.xdist_group("clusters")]
 
 
-@pytest.fixture(scope="module")
-def cluster():
+@contextmanager
+def dask_cluster(workers: int = 2) -> Iterator[str]:
     """A dask cluster started as on real machines, from the command lines a cluster's are started with: a
-    ``dask scheduler`` and two ``dask worker`` processes of one thread each, here on the loopback; the
+    ``dask scheduler`` and ``workers`` ``dask worker`` processes of one thread each, here on the loopback; the
     scheduler's address."""
     pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
     dask = shutil.which("dask", path=os.path.dirname(sys.executable))
@@ -53,11 +54,11 @@ def cluster():
     try:
         started += [subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--host", "127.0.0.1",
                                       "--dashboard-address", "127.0.0.1:0", "--name", f"worker-{i}"], **quiet)
-                    for i in range(2)]
+                    for i in range(workers)]
         from distributed import Client
 
         with Client(address, timeout=60) as client:
-            client.wait_for_workers(2, timeout=120)
+            client.wait_for_workers(workers, timeout=120)
         yield address
     finally:
         for process in reversed(started):  # the workers, then the scheduler
@@ -65,9 +66,15 @@ def cluster():
             process.wait(timeout=60)
 
 
-def loky_records(runs: list, tmp_path) -> pd.DataFrame:
+@pytest.fixture(scope="module")
+def cluster():
+    with dask_cluster() as address:
+        yield address
+
+
+def loky_records(runs: list, tmp_path, experiment: str = "hspf_ungm") -> pd.DataFrame:
     """The reference: the runs' records computed by the default local backend."""
-    loky = Store(tmp_path / "loky", "hspf_ungm")
+    loky = Store(tmp_path / "loky", experiment)
     assert execute(runs, loky, n_jobs=2, backend="loky", progress=False) == len(runs)
     return deterministic_columns(loky.load(runs))
 
@@ -95,6 +102,44 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, c
         cli, tmp_path, runs, expected,
         "parallel.backend=dask", f"parallel.address={cluster}", timeout=120,
     )
+
+
+# four short runs, then two of several seconds, one per worker: one of those is lost with its worker
+LOST = ("scale=quick", "experiment.runs.quick=1", "~experiment.methods.grid",
+        "experiment.methods.PF.sweep.n_particles=[100]", "experiment.model.sweep.steps=[10,11,12,13,150000,150001]")
+
+
+def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_else(make_cfg, tmp_path):
+    """``kill -9`` of a dask worker in mid-run (as the kernel's out-of-memory killer does): its nanny starts a
+    new one, the scheduler sends the lost run again, and the command ends as usual.  Exactly one run starts
+    after the kill (its record's ``computed_at - wall_s``); the runs stored before it are not written again; and
+    the store ends with loky's records."""
+    from distributed import Client
+
+    runs = expand(make_cfg("ungm_horizon", *LOST))
+    store = tmp_path / "store"
+    with dask_cluster() as address, Client(address, timeout=60) as client:
+        pids = client.run(os.getpid)  # each worker process's, the nanny's child
+        runner = subprocess.Popen(command("ungm_horizon", store, tmp_path / "reports", *LOST, "parallel.backend=dask",
+                                          f"parallel.address={address}"),
+                                  cwd=PROJECT_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 300
+        while not (len(stored := sorted(store.glob("ungm_horizon/runs/*.json"))) == 4
+                   and all(client.processing().values())):  # the short four stored, both long runs under way
+            assert runner.poll() is None and time.monotonic() < deadline, runner.communicate()
+            time.sleep(0.05)
+        before = {path: path.stat().st_mtime_ns for path in stored}
+        time.sleep(1.0)  # computed_at has whole seconds
+        killed_at = time.time()
+        os.kill(pids[next(iter(client.processing()))], signal.SIGKILL)
+        out, err = runner.communicate(timeout=300)
+    assert runner.returncode == 0, err
+    assert "6 runs computed" in out, out
+    assert {path: path.stat().st_mtime_ns for path in before} == before
+    records = Store(store, "ungm_horizon").load(runs)
+    started = pd.to_datetime(records["computed_at"]).map(pd.Timestamp.timestamp) - records["wall_s"]
+    assert (started > killed_at).sum() == 1, records[["run_id", "computed_at", "wall_s"]]
+    pd.testing.assert_frame_equal(deterministic_columns(records), loky_records(runs, tmp_path, "ungm_horizon"))
 
 
 @pytest.fixture(scope="module")
@@ -153,6 +198,38 @@ def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ra
         "parallel.backend=ray", f"parallel.address={ray_head}",
         timeout=180, env=ray_env,
     )
+
+
+MULTIVERSE = ("scale=quick", "experiment.multiverse.runs.quick=2")  # hspf_readings: 2 experiments x its universes
+
+
+def every_record(store: Path) -> pd.DataFrame:
+    """Every run a store holds, of every experiment (a multiverse's universes among them), as written."""
+    return pd.concat([stored_table(store, folder.parent.name) for folder in sorted(store.glob("*/runs"))],
+                     ignore_index=True)
+
+
+@pytest.fixture(scope="module")
+def multiverse_by_loky(tmp_path_factory) -> pd.DataFrame:
+    store = tmp_path_factory.mktemp("loky") / "store"
+    done = subprocess.run(command("hspf_readings", store, store.parent / "reports", *MULTIVERSE), cwd=PROJECT_ROOT,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    return every_record(store)
+
+
+@pytest.mark.parametrize("backend, head", [("dask", "cluster"), ("ray", "ray_head")])
+def test_a_multiverse_on_a_cluster_started_from_its_command_lines_stores_loky_s_records(
+        backend, head, request, tmp_path, multiverse_by_loky):
+    """``make readings ADDRESS=...``'s command: every universe's runs as loky computes them on this machine."""
+    env = local_backend_env(backend, request)
+    store = tmp_path / "store"
+    done = subprocess.run(command("hspf_readings", store, tmp_path / "reports", *MULTIVERSE, f"parallel.backend={backend}",
+                                  f"parallel.address={request.getfixturevalue(head)}"),
+                          cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=600, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "universes of" in done.stdout, done.stdout
+    pd.testing.assert_frame_equal(every_record(store), multiverse_by_loky)
 
 
 @pytest.mark.parametrize("backend", ["threading", "dask", "ray"])

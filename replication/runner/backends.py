@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from joblib import parallel_config, register_parallel_backend
 
 from replication.kinds import Registry
-from replication.runner.lifeline import start_worker
+from replication.runner import lifeline
 
 STOP_S = 1.0  # an interrupted local dask worker is killed after this long, its run unfinished
 
@@ -83,7 +83,7 @@ def parallel_backend(backend: str = "loky", n_jobs: int = 2, address: str | None
 @contextmanager
 def _loky(n_jobs: int, address: str | None) -> Iterator[None]:
     """Worker processes on this machine, each watching this process so none outlives it (:mod:`.lifeline`)."""
-    with parallel_config(backend="loky", n_jobs=n_jobs, initializer=start_worker, initargs=(os.getpid(),)):
+    with parallel_config(backend="loky", n_jobs=n_jobs, initializer=lifeline.start_worker, initargs=(os.getpid(),)):
         yield
 
 
@@ -130,6 +130,7 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
         except OSError as error:
             raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
     with nullcontext() if address else _ray_on_the_loopback():
+        before = lifeline.children()
         try:
             with _sigterm_kept(), warnings.catch_warnings():
                 warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
@@ -146,7 +147,9 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
                                    f"ray release ignores {RAY_LOCAL_ONLY}=0; use parallel.backend=dask")
             yield
         finally:
+            started = set() if address else lifeline.descendants(lifeline.children() - before)
             ray.shutdown()
+            lifeline.end_within(started, RAY_SHUTDOWN_S)  # the agents its raylet starts may outlive it, under load
 
 
 def _register_ray() -> None:
@@ -162,6 +165,7 @@ def _register_ray() -> None:
     register_parallel_backend("ray", Stopping)
 
 
+RAY_SHUTDOWN_S = 5.0  # after ray.shutdown(), the seconds a local cluster's processes have to end before SIGKILL
 RAY_LOCAL_ONLY = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # "0": ray without clusters, its node on the loopback
 
 

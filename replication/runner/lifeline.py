@@ -6,8 +6,8 @@ included) and whether the child is computing or waiting.  The loky workers get i
 initializer (:func:`start_worker`), and their resource trackers exit
 once no worker holds their pipe; a companion experiment (``also:``) gets it from the environment
 its runner starts it with (:func:`child_environment`, :func:`watch_parent_from_environment`).  The
-dask backend's local workers die with their parent already (distributed watches it); ray's
-processes are ray's to manage.
+dask backend's local workers die with their parent already (distributed watches it); a local ray
+cluster's processes are ended with it (:func:`end_within`), the agents its raylet starts included.
 """
 
 import gc
@@ -78,12 +78,53 @@ def stop_children() -> None:
     loky worker caught starting (its interpreter not yet up to read its task, nor holding its lifeline), which
     Python's exit would otherwise wait for, seconds each.  A worker dies of it; a companion runner stops as
     after Ctrl-C; a resource tracker ignores it and ends when its last user has.  Linux (``/proc``) only."""
+    for pid in children():
+        try:
+            os.kill(pid, signal.SIGTERM)
+        except OSError:  # gone meanwhile, or not ours to signal
+            continue
+
+
+def _processes() -> dict[int, tuple[int, str]]:
+    """Every live process's parent and state, from ``/proc`` (empty where there is none)."""
+    table = {}
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             state, parent = stat.read_text().rsplit(")", 1)[1].split()[:2]
-            if int(parent) == os.getpid() and state != "Z":
-                os.kill(int(stat.parent.name), signal.SIGTERM)
-        except (OSError, ValueError):  # gone meanwhile, or not ours to signal
+            table[int(stat.parent.name)] = int(parent), state
+        except (OSError, ValueError):  # gone meanwhile
+            continue
+    return table
+
+
+def children() -> set[int]:
+    """This process's running children (not zombies)."""
+    return {pid for pid, (parent, state) in _processes().items() if parent == os.getpid() and state != "Z"}
+
+
+def descendants(roots: set[int]) -> set[int]:
+    """``roots`` still running, the processes they started, the ones those started, and so on."""
+    table = _processes()
+    found = layer = {pid for pid in roots if pid in table}
+    while layer:
+        layer = {pid for pid, (parent, _) in table.items() if parent in layer} - found
+        found = found | layer
+    return _running(found, table)
+
+
+def _running(pids: set[int], table: dict[int, tuple[int, str]]) -> set[int]:
+    return {pid for pid in pids if pid in table and table[pid][1] != "Z"}
+
+
+def end_within(pids: set[int], seconds: float) -> None:
+    """Wait up to ``seconds`` for ``pids`` to end by themselves, then SIGKILL every one left."""
+    deadline = time.monotonic() + seconds
+    while (left := _running(pids, _processes())) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    for pid in left:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except OSError:  # ended meanwhile
             continue
 
 
