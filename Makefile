@@ -1,4 +1,5 @@
-# make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html and reports/replication.pdf
+# make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html
+# make pdf         reports/replication.pdf: the scorecard, tables and figures of every report drawn (after make replicate)
 # make test        set up and run the test suite on JOBS (2) workers (the long paper-scale runs are marked slow and skipped)
 # make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
 # make report      redraw every report from the stored runs, running nothing
@@ -36,7 +37,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-fast test-all replicate readings report benchmark docs calibrate record verify findings
+.PHONY: setup browser test test-fast test-all replicate pdf readings report benchmark docs calibrate record verify findings
 
 setup: $(VENV)/.installed
 
@@ -72,13 +73,18 @@ test-all: setup browser
 # machine's runs, then which of them are recorded runs and whether they agree.  At SCALE=paper the runs the
 # record holds as this code computes them are read from it, not computed (skip_recorded=false in conf/config.yaml
 # computes all), and the record is rewritten with the runs just made (a file whose runs did not change keeps its bytes).
+# The runs draw no report as they go (draw=false): every experiment's is drawn after them, JOBS at a time,
+# instead of one at a time between experiments while the workers wait.  The PDF is make pdf's.
 replicate: setup
 	$(BIN)/python -m replication report source=record pdf=false
-	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS)
+	$(BIN)/python -m replication --multirun experiment=$(subst $(space),$(comma),$(REPLICATE)) scale=$(SCALE) n_jobs=$(JOBS) draw=false
 	$(if $(filter paper,$(SCALE)),$(MAKE) record)
+	$(BIN)/python -m replication report scale=$(SCALE) n_jobs=$(JOBS) pdf=false
 	$(BIN)/python -m replication verify against=store scale=$(SCALE)
 	$(BIN)/python benchmarks/benchmark.py
 	$(BIN)/python -m replication.report.calibration
+
+pdf: setup
 	$(BIN)/python -m replication.report.pdf
 
 # At SCALE=paper the universes the record holds as this code computes them are read from it, not run

@@ -1,7 +1,8 @@
 """Parallel efficiency and the scheduling overhead per run of every backend, at 1 and 2 workers (issue 59, item 5).
 
 ``python benchmarks/cluster.py [EXPERIMENT] [override ...]`` (default: ``hspf_ungm scale=quick
-experiment.runs.quick=6``, about 80 runs of 0.1-1 s).  The same runs are computed
+experiment.runs.quick=120``: 360 runs of about 0.1 s, short enough for scheduling to show).  The same runs are
+computed
 
 1. one after another in this process (``perform``), after one warm-up run of each method: the serial time
    ``T1``, the sum of the runs' own wall times;
@@ -18,16 +19,21 @@ first's.  The machine's one-minute load is logged beside every figure.  Writes
 """
 
 import os
+import secrets
+import tempfile
 
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # as in the runner's workers
     os.environ.setdefault(_variable, "1")
+# the ray heads' files in a folder of this script's own, and their token, in this process's environment before
+# anything reads it: the heads started here and this process, which joins them, share both
+RAY_ENV = {"RAY_TMPDIR": tempfile.mkdtemp(prefix="ray", dir="/tmp"), "RAY_AUTH_MODE": "token",
+           "RAY_AUTH_TOKEN": secrets.token_hex(32)}
+os.environ.update(RAY_ENV)
 
-import secrets  # noqa: E402
 import shutil  # noqa: E402
 import socket  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
-import tempfile  # noqa: E402
 import time  # noqa: E402
 from contextlib import contextmanager, nullcontext  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -40,7 +46,7 @@ from replication.runner.config import expand  # noqa: E402
 from replication.runner.execute import TIMING_COLUMNS, execute, perform  # noqa: E402
 from replication.runner.store import Store  # noqa: E402
 
-DEFAULT = ("hspf_ungm", "scale=quick", "experiment.runs.quick=6")
+DEFAULT = ("hspf_ungm", "scale=quick", "experiment.runs.quick=120")
 WORKERS = (1, 2)
 
 
@@ -78,28 +84,21 @@ def dask_cluster(workers: int):
 
 @contextmanager
 def ray_cluster(workers: int):
-    """``ray start --head --num-cpus=workers`` on the loopback, its files in a folder of its own."""
-    folder = tempfile.mkdtemp(prefix="ray", dir="/tmp")
-    env = {**os.environ, "RAY_TMPDIR": folder, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(32)}
+    """``ray start --head --num-cpus=workers``, its files and token those of :data:`RAY_ENV`."""
     port = free_port()
     head = subprocess.Popen([command_line("ray"), "start", "--head", f"--port={port}", f"--num-cpus={workers}",
                              "--include-dashboard=false", "--disable-usage-stats", "--block"],
-                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    address, saved = f"127.0.0.1:{port}", dict(os.environ)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    address = f"127.0.0.1:{port}"
     try:
-        while subprocess.run([command_line("ray"), "status", f"--address={address}"], env=env,
-                             capture_output=True).returncode:
+        while subprocess.run([command_line("ray"), "status", f"--address={address}"], capture_output=True).returncode:
             if head.poll() is not None:
                 raise RuntimeError("the ray head node did not start")
             time.sleep(1)
-        os.environ.update(env)  # this process joins it with the head's token
         yield address
     finally:
-        os.environ.clear()
-        os.environ.update(saved)
         head.terminate()
         head.wait(timeout=60)
-        shutil.rmtree(folder, ignore_errors=True)
 
 
 CLUSTERS = {"loky": lambda workers: nullcontext(None), "dask": dask_cluster, "ray": ray_cluster}
@@ -146,6 +145,7 @@ def main(arguments: list[str]) -> None:
     out = resolve("reports") / "benchmark"
     out.mkdir(parents=True, exist_ok=True)
     table.to_csv(out / "cluster.csv", index=False)
+    shutil.rmtree(RAY_ENV["RAY_TMPDIR"], ignore_errors=True)
     print(f"\nevery backend stored the same records; written to {out / 'cluster.csv'}")
 
 

@@ -150,6 +150,23 @@ def interrupted(store=None, runs=None) -> None:
     raise SystemExit(interrupt_status())
 
 
+def draw_experiment(cfg: DictConfig, runs: list, held) -> None:
+    """The experiment's report from its runs (``held``: the store's, and the record's beneath them), judged
+    (evidence), then drawn (report), and the index with its new summary."""
+    from hydra.core.hydra_config import HydraConfig
+
+    from replication.evidence.scorecard import Scorecard
+    from replication.report.experiments import write_experiment
+    from replication.report.pages.index import write_index
+    from replication.runner.results import Results
+
+    results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
+    written = write_experiment(cfg, results)
+    # the scorecard with this experiment's new summary, against the same published values as the page
+    index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
+    print(f"{cfg.experiment.name}: report in {written}; index in {index}")
+
+
 @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base="1.3")
 def run_experiment(cfg: DictConfig) -> None:
     # the numerical stack is imported here, after every check that does not need it has passed
@@ -194,19 +211,9 @@ def run_experiment(cfg: DictConfig) -> None:
         stored = len(computed) - done
         print(f"{cfg.experiment.name}: {done} runs computed, {stored} already stored in {store.directory}"
               + (f", {len(held.recorded)} read from the record" if held.recorded else ""))
-        from replication.report.experiments import write_experiment
-        from replication.evidence.scorecard import Scorecard
-        from replication.report.pages.index import write_index
-        from hydra.core.hydra_config import HydraConfig
-
-        from replication.runner.results import Results
-
-        results = Results.of(cfg, runs, held, tuple(HydraConfig.get().overrides.task), held.curves)
-        written = write_experiment(cfg, results)  # judged (evidence), then drawn (report)
-        # the scorecard with this experiment's new summary, against the same published values as the page
-        index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
-        print(f"{cfg.experiment.name}: report in {written}; index in {index}")
-        if results.own and cfg.experiment.get("also"):
+        if cfg.draw:
+            draw_experiment(cfg, runs, held)
+        if reported_as != cfg.experiment.name and cfg.experiment.get("also"):
             print(f"skipped: {', '.join(cfg.experiment.also)}, run beside {cfg.experiment.name} as shipped, since "
                   "this request changes it (your data or settings); run one by name if you want it", file=sys.stderr)
         else:
@@ -287,15 +294,17 @@ def run_multiverse(cfg: DictConfig) -> None:
                 done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
                 print(f"{where}: {experiment}: {done} runs computed, {len(runs) - done} already stored"
                       + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
-        from hydra.core.hydra_config import HydraConfig
+        if cfg.draw:
+            from hydra.core.hydra_config import HydraConfig
 
-        from replication.evidence.scorecard import Scorecard
-        from replication.report.experiments import write_multiverse
-        from replication.report.pages.index import write_index
+            from replication.evidence.scorecard import Scorecard
+            from replication.report.experiments import write_multiverse
+            from replication.report.pages.index import write_index
 
-        written = write_multiverse(cfg, multiverse, tuple(HydraConfig.get().overrides.task), reader(recorded, layers))
-        index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
-        print(f"{name}: report in {written}; index in {index}")
+            written = write_multiverse(cfg, multiverse, tuple(HydraConfig.get().overrides.task),
+                                       reader(recorded, layers))
+            index = write_index(resolve(cfg.reports), Scorecard.read(resolve(cfg.reports), cfg.published_values))
+            print(f"{name}: report in {written}; index in {index}")
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
     except KeyboardInterrupt:

@@ -109,6 +109,7 @@ CONFIG_ERRORS = [
     Bad(("experiment=hspf_ungm", "outside_project=maybe"), "outside_project"),
     Bad(("experiment=hspf_ungm", "skip_recorded=1"), "skip_recorded must be true or false"),
     Bad(("experiment=hspf_ungm", "dry_run=yes"), "dry_run must be true or false"),
+    Bad(("experiment=hspf_ungm", "draw=no"), "draw must be true or false"),
     Bad(("experiment=hspf_ungm", "record=null"), "record must be a folder"),
     Bad(("experiment=hspf_ungm", "n_job=4"), "unknown key 'n_job'"),
     Bad(("experiment=hspf_ungm", "experiment.methods.PF.bogus=1"), "unknown key 'experiment.methods.PF.bogus'"),

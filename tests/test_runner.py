@@ -395,3 +395,25 @@ def test_a_table_whose_scene_is_not_run_is_named_before_any_work(make_cfg):
                      "will leave it out"]  # table3_stability matches 16 balls too: it stays
     _, everything, _ = prepare(make_cfg("bis_pf", "scale=quick"))
     assert not [line for line in everything if "table" in line]
+
+
+@pytest.mark.e2e  # subprocesses: make test-fast leaves it out
+def test_runs_stored_without_a_report_are_drawn_later_as_if_drawn_as_they_went(cli, tmp_path):
+    """``draw=false`` (make replicate's runs) computes and stores the runs and draws nothing; the report
+    command then draws the page and summary that drawing as the runs go gives (from the same stored runs)."""
+    settings = ("experiment=hspf_ungm", "experiment.runs.quick=2", "scale=quick")
+    stored = cli(*settings, "draw=false")
+    assert stored.returncode == 0, stored.stderr
+    assert "runs computed, 0 already stored" in stored.stdout and "report in" not in stored.stdout
+    page = tmp_path / "reports" / "quick" / "hspf_ungm"
+    assert not page.exists()
+    later = subprocess.run([sys.executable, "-m", "replication", "report", *settings, "pdf=false",
+                            f"store={tmp_path / 'experiments'}", f"reports={tmp_path / 'reports'}",
+                            "outside_project=true", "progress=false"],
+                           cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=300)
+    assert later.returncode == 0, later.stderr
+    summary = json.loads((page / "summary.json").read_text())
+    drawn = cli(*settings)
+    assert drawn.returncode == 0, drawn.stderr
+    assert "0 runs computed" in drawn.stdout and "hspf_ungm: report in" in drawn.stdout
+    assert json.loads((page / "summary.json").read_text()) == summary

@@ -64,7 +64,7 @@ def check_settings(cfg: DictConfig) -> None:
         raise ConfigError(f"n_jobs must be a positive number of workers or -1 for all cores, got {n_jobs!r}")
     if cfg.get("scale") not in SCALES:
         raise ConfigError(f"scale must be one of {', '.join(SCALES)}, got {cfg.get('scale')!r}")
-    for flag in ("outside_project", "skip_recorded", "dry_run", "n_jobs_beyond_cores"):
+    for flag in ("outside_project", "skip_recorded", "dry_run", "n_jobs_beyond_cores", "draw"):
         if not isinstance(cfg.get(flag), bool):
             raise ConfigError(f"{flag} must be true or false, got {cfg.get(flag)!r}")
     record = cfg.get("record")
