@@ -104,9 +104,10 @@ def test_dask_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, c
     )
 
 
-# four short runs, then two of several seconds, one per worker: one of those is lost with its worker
+# two short runs and two of several seconds, one per worker: one of those is lost with its worker.  Four runs,
+# all sent at once (joblib sends 2 x the workers before it sizes batches by their times: never both long together)
 LOST = ("scale=quick", "experiment.runs.quick=1", "~experiment.methods.grid",
-        "experiment.methods.PF.sweep.n_particles=[100]", "experiment.model.sweep.steps=[10,11,12,13,150000,150001]")
+        "experiment.methods.PF.sweep.n_particles=[100]", "experiment.model.sweep.steps=[10,11,150000,150001]")
 
 
 def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_else(make_cfg, tmp_path):
@@ -124,8 +125,8 @@ def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_el
                                           f"parallel.address={address}"),
                                   cwd=PROJECT_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         deadline = time.monotonic() + 300
-        while not (len(stored := sorted(store.glob("ungm_horizon/runs/*.json"))) == 4
-                   and all(client.processing().values())):  # the short four stored, both long runs under way
+        while not (len(stored := sorted(store.glob("ungm_horizon/runs/*.json"))) == 2
+                   and all(client.processing().values())):  # the short two stored, both long runs under way
             assert runner.poll() is None and time.monotonic() < deadline, runner.communicate()
             time.sleep(0.05)
         before = {path: path.stat().st_mtime_ns for path in stored}
@@ -134,7 +135,7 @@ def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_el
         os.kill(pids[next(iter(client.processing()))], signal.SIGKILL)
         out, err = runner.communicate(timeout=300)
     assert runner.returncode == 0, err
-    assert "6 runs computed" in out, out
+    assert "4 runs computed" in out, out
     assert {path: path.stat().st_mtime_ns for path in before} == before
     records = Store(store, "ungm_horizon").load(runs)
     started = pd.to_datetime(records["computed_at"]).map(pd.Timestamp.timestamp) - records["wall_s"]
