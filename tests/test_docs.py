@@ -46,6 +46,9 @@ ALLOWED: dict[str, str] = {
                   "measured 2026-11-28)",
     "9 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
                  "(8 min 29 s at 161a222, measured 2026-11-26)",
+    "12 minutes": "README: `make replicate` from a fresh clone with an empty HOME on the 2-core machine, setting "
+                  "itself up included, nothing else running (12 min 5 s at 1f7338d, measured 2026-11-29: setup "
+                  "80 s, the record's pages 131 s, the quick runs 395 s, their reports 79 s, the checks 41 s)",
     "10 minutes": "README: `make verify`'s default 200 recorded runs on the 2-core machine, re-computed and the "
                   "verdicts judged again (over 10 minutes, issue 57's new-user test at f29efe1, 2026-11-27)",
     # docs/reproducibility.md, how verify's tolerance was chosen (issue 56), measured 2026-11-27 at b6790c6 on
