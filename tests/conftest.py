@@ -115,3 +115,23 @@ def typed(records):
                   for label in records["condition"]]
     columns = pd.DataFrame([c.columns() for c in conditions], index=records.index, dtype=object)
     return pd.concat([records, columns], axis=1) if len(columns.columns) else records
+
+
+def libm_exp(x):
+    """exp element by element from the C library, as the compiled kernels call it: the same bits on every CPU.
+    numpy's own exp takes a vector path chosen by the CPU (AVX-512F where there is one) and may differ from it
+    in the last bit, so a kernel checked against a numpy form "to the bit" is checked against this exp."""
+    import math
+
+    import numpy as np
+
+    return np.vectorize(math.exp, otypes=[float])(x)
+
+
+def libm_log(x):
+    """log element by element from the C library: as :func:`libm_exp`, numpy's own log is CPU-dispatched."""
+    import math
+
+    import numpy as np
+
+    return np.vectorize(math.log, otypes=[float])(x)

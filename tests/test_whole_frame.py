@@ -4,6 +4,7 @@ synthetic scene of balls; and their compiled parts give numpy's bits (sums, BLAS
 
 import numpy as np
 import pytest
+from conftest import libm_exp, libm_log
 
 from replication import BISPF, bootstrap
 from replication.compiled import matvec
@@ -148,7 +149,7 @@ def test_mean_field_and_dmot_interactions_are_their_numpy_forms_to_the_bit():
                 table = log_potential_table(clouds[i][r], clouds[j][c], 4.0)
                 field[i][r] += table @ q[j][c]
                 field[j][c] += table.T @ q[i][r]
-            q = [normalise(np.log(p) + f)[0] for p, f in zip(pi, field)]
+            q = [normalise(libm_log(p) + f)[0] for p, f in zip(pi, field)]
         found = MFMC(n_particles=n, iterations=3, beta=4.0).interact(clouds, pi, None)
         assert all(a.tobytes() == b.tobytes() for a, b in zip(found, q))
         dmot = DMOT(sigma_angle=0.4, sigma_speed=1.5, alpha2=1.5)
@@ -158,7 +159,7 @@ def test_mean_field_and_dmot_interactions_are_their_numpy_forms_to_the_bit():
         norms = np.linalg.norm(motion, axis=1) * np.linalg.norm(reference)
         theta = np.arccos(np.clip(np.divide(motion @ reference, norms, out=np.ones(n), where=norms > 0), -1.0, 1.0))
         speed = np.linalg.norm(motion, axis=1) - np.linalg.norm(reference)
-        inertia = 1.0 + np.exp(-(theta**2) / 0.4**2) * np.exp(-(speed**2) / 1.5**2) / 1.5
+        inertia = 1.0 + libm_exp(-(theta**2) / 0.4**2) * libm_exp(-(speed**2) / 1.5**2) / 1.5
         assert dmot.inertia(clouds[0], means).tobytes() == inertia.tobytes()
         assert (dmot.inertia(clouds[0], means[:1]) == 1.0).all()
 
