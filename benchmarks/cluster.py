@@ -31,11 +31,9 @@ RAY_ENV = {"RAY_TMPDIR": tempfile.mkdtemp(prefix="ray", dir="/tmp"), "RAY_AUTH_M
 os.environ.update(RAY_ENV)
 
 import shutil  # noqa: E402
-import socket  # noqa: E402
-import subprocess  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from contextlib import contextmanager, nullcontext  # noqa: E402
+from contextlib import nullcontext  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import pandas as pd  # noqa: E402
@@ -44,64 +42,14 @@ from hydra import compose, initialize_config_dir  # noqa: E402
 from replication.paths import CONF_DIR, resolve  # noqa: E402
 from replication.runner.config import expand  # noqa: E402
 from replication.runner.execute import TIMING_COLUMNS, execute, perform  # noqa: E402
+from replication.runner.loopback import dask_cluster, ray_cluster  # noqa: E402
 from replication.runner.store import Store  # noqa: E402
 
 DEFAULT = ("hspf_ungm", "scale=quick", "experiment.runs.quick=120")
 WORKERS = (1, 2)
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def command_line(name: str) -> str:
-    return shutil.which(name, path=os.path.dirname(sys.executable))
-
-
-@contextmanager
-def dask_cluster(workers: int):
-    """``dask scheduler`` and ``workers`` ``dask worker`` processes of one thread, on the loopback."""
-    from distributed import Client
-
-    port, quiet = free_port(), {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    address = f"tcp://127.0.0.1:{port}"
-    started = [subprocess.Popen([command_line("dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                                 "--dashboard-address", "127.0.0.1:0", "--no-show"], **quiet)]
-    try:
-        started += [subprocess.Popen([command_line("dask"), "worker", address, "--nthreads", "1", "--host",
-                                      "127.0.0.1", "--dashboard-address", "127.0.0.1:0"], **quiet)
-                    for _ in range(workers)]
-        with Client(address, timeout=60) as client:
-            client.wait_for_workers(workers, timeout=120)
-        yield address
-    finally:
-        for process in reversed(started):
-            process.terminate()
-            process.wait(timeout=60)
-
-
-@contextmanager
-def ray_cluster(workers: int):
-    """``ray start --head --num-cpus=workers``, its files and token those of :data:`RAY_ENV`."""
-    port = free_port()
-    head = subprocess.Popen([command_line("ray"), "start", "--head", f"--port={port}", f"--num-cpus={workers}",
-                             "--include-dashboard=false", "--disable-usage-stats", "--block"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    address = f"127.0.0.1:{port}"
-    try:
-        while subprocess.run([command_line("ray"), "status", f"--address={address}"], capture_output=True).returncode:
-            if head.poll() is not None:
-                raise RuntimeError("the ray head node did not start")
-            time.sleep(1)
-        yield address
-    finally:
-        head.terminate()
-        head.wait(timeout=60)
-
-
-CLUSTERS = {"loky": lambda workers: nullcontext(None), "dask": dask_cluster, "ray": ray_cluster}
+CLUSTERS = {"loky": lambda workers: nullcontext(None), "dask": dask_cluster, "ray": ray_cluster}  # ray: RAY_ENV
 
 
 def records(store: Store, runs) -> pd.DataFrame:

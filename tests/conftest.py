@@ -1,4 +1,5 @@
 import gc
+import math
 import os
 import signal
 import sys
@@ -117,21 +118,14 @@ def typed(records):
     return pd.concat([records, columns], axis=1) if len(columns.columns) else records
 
 
-def libm_exp(x):
-    """exp element by element from the C library, as the compiled kernels call it: the same bits on every CPU.
-    numpy's own exp takes a vector path chosen by the CPU (AVX-512F where there is one) and may differ from it
-    in the last bit, so a kernel checked against a numpy form "to the bit" is checked against this exp."""
-    import math
-
+def c_library(function):
+    """``function``, one of :mod:`math`'s (the C library's, as the compiled kernels call it), element by element:
+    the same bits on every CPU.  numpy's own exp and log take a vector path chosen by the CPU (AVX-512F where
+    there is one) and may differ from the C library's in the last bit, so a kernel checked against a numpy
+    form "to the bit" is checked against these."""
     import numpy as np
 
-    return np.vectorize(math.exp, otypes=[float])(x)
+    return np.vectorize(function, otypes=[float])
 
 
-def libm_log(x):
-    """log element by element from the C library: as :func:`libm_exp`, numpy's own log is CPU-dispatched."""
-    import math
-
-    import numpy as np
-
-    return np.vectorize(math.log, otypes=[float])(x)
+libm_exp, libm_log = c_library(math.exp), c_library(math.log)

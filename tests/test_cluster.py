@@ -8,13 +8,9 @@ import os
 import secrets
 import shutil
 import signal
-import socket
 import subprocess
-import sys
 import tempfile
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -27,6 +23,7 @@ from test_reliability import (
 from replication.runner.config import expand
 from replication.runner.backends import CLUSTER_PACKAGES
 from replication.runner.execute import execute
+from replication.runner.loopback import dask_cluster, ray_cluster
 from replication.runner.store import Store
 
 TINY = ("scale=quick", "experiment.runs.quick=2")
@@ -37,38 +34,10 @@ TINY = ("scale=quick", "experiment.runs.quick=2")
 pytestmark = [pytest.mark.e2e, pytest.mark.xdist_group("clusters")]
 
 
-@contextmanager
-def dask_cluster(workers: int = 2) -> Iterator[str]:
-    """A dask cluster started as on real machines, from the command lines a cluster's are started with: a
-    ``dask scheduler`` and ``workers`` ``dask worker`` processes of one thread each, here on the loopback; the
-    scheduler's address."""
-    pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
-    dask = shutil.which("dask", path=os.path.dirname(sys.executable))
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    address = f"tcp://127.0.0.1:{port}"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    started = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                                 "--dashboard-address", "127.0.0.1:0", "--no-show"], **quiet)]
-    try:
-        started += [subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--host", "127.0.0.1",
-                                      "--dashboard-address", "127.0.0.1:0", "--name", f"worker-{i}"], **quiet)
-                    for i in range(workers)]
-        from distributed import Client
-
-        with Client(address, timeout=60) as client:
-            client.wait_for_workers(workers, timeout=120)
-        yield address
-    finally:
-        for process in reversed(started):  # the workers, then the scheduler
-            process.terminate()
-            process.wait(timeout=60)
-
-
 @pytest.fixture(scope="module")
 def cluster():
-    with dask_cluster() as address:
+    pytest.importorskip("distributed", reason="distributed is not installed (pip install -e '.[test]')")
+    with dask_cluster(2) as address:
         yield address
 
 
@@ -119,7 +88,7 @@ def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_el
 
     runs = expand(make_cfg("ungm_horizon", *LOST))
     store = tmp_path / "store"
-    with dask_cluster() as address, Client(address, timeout=60) as client:
+    with dask_cluster(2) as address, Client(address, timeout=60) as client:
         pids = client.run(os.getpid)  # each worker process's, the nanny's child
         runner = subprocess.Popen(command("ungm_horizon", store, tmp_path / "reports", *LOST, "parallel.backend=dask",
                                           f"parallel.address={address}"),
@@ -169,25 +138,8 @@ def ray_head(ray_env):
     """A ray head node of 2 CPUs started as on a real cluster (``ray start --head``); its address.
     It and the command that joins it authenticate with the token in ``ray_env``."""
     pytest.importorskip("ray", reason="ray is not installed (pip install -e '.[test]')")
-    ray = shutil.which("ray", path=os.path.dirname(sys.executable))
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    head = subprocess.Popen(
-        [ray, "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
-         "--disable-usage-stats", "--block"],
-        env=ray_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )
-    address = f"127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 120
-        while subprocess.run([ray, "status", f"--address={address}"], env=ray_env, capture_output=True).returncode:
-            assert head.poll() is None and time.monotonic() < deadline, "the ray head node did not come up"
-            time.sleep(1)
+    with ray_cluster(2, ray_env) as address:
         yield address
-    finally:
-        head.terminate()  # --block: the head stops every process it started
-        head.wait(timeout=60)
 
 
 def test_ray_cluster_stores_the_same_records_as_loky(make_cfg, cli, tmp_path, ray_env, ray_head):
