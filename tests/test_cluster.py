@@ -112,6 +112,63 @@ def test_a_run_lost_with_its_killed_dask_worker_is_computed_again_and_nothing_el
     pd.testing.assert_frame_equal(deterministic_columns(records), loky_records(runs, tmp_path, "ungm_horizon"))
 
 
+def cmdline(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:  # ended meanwhile
+        return ""
+
+
+def loky_workers(runner: subprocess.Popen) -> set[int]:
+    """The runner's loky worker processes (not loky's resource tracker)."""
+    return {pid for pid in descendants(runner.pid) if "popen_loky_posix" in cmdline(pid)}
+
+
+def ray_workers(runner: subprocess.Popen) -> set[int]:
+    """The ray worker processes computing a joblib batch (ray titles them ``ray::PoolActor.run_batch``)."""
+    return {pid for pid in processes() if cmdline(pid).startswith("ray::PoolActor.run_batch")}
+
+
+# loky returns each run as it ends, so the two short runs are stored while the long ones are under way; ray's
+# joblib backend returns a worker's batch (here a short and a long run) whole, so none is stored before the end
+@NEEDS_PROC
+@pytest.mark.parametrize("backend, workers, stored_first", [("loky", loky_workers, 2), ("ray", ray_workers, 0)])
+def test_a_worker_killed_in_mid_run_ends_the_command_in_one_line_and_its_rerun_computes_what_was_lost(
+        backend, workers, stored_first, make_cfg, request, tmp_path):
+    """loky and ray give up on the runs of a worker killed with ``kill -9`` (dask sends them again: above):
+    the command ends with one line saying how many runs are stored and to rerun it, the runs stored before
+    the kill are kept as they are, and the same command computes the lost ones and nothing else, to loky's
+    records."""
+    cluster, env = (), None
+    if backend == "ray":
+        cluster = ("parallel.backend=ray", f"parallel.address={request.getfixturevalue('ray_head')}")
+        env = request.getfixturevalue("ray_env")
+    runs = expand(make_cfg("ungm_horizon", *LOST))
+    store = tmp_path / "store"
+    asked = command("ungm_horizon", store, tmp_path / "reports", *LOST, *cluster)
+    runner = subprocess.Popen(asked, cwd=PROJECT_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True, env=env)
+    deadline = time.monotonic() + 300
+    while not (len(list(store.glob("ungm_horizon/runs/*.json"))) == stored_first and len(workers(runner)) == 2):
+        assert runner.poll() is None and time.monotonic() < deadline, runner.communicate()
+        time.sleep(0.05)
+    time.sleep(1.0)  # both long runs under way
+    before = {path: path.stat().st_mtime_ns for path in sorted(store.glob("ungm_horizon/runs/*.json"))}
+    os.kill(min(workers(runner)), signal.SIGKILL)
+    out, err = runner.communicate(timeout=300)
+    assert runner.returncode == 2, (out, err)
+    said = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert len(said) == 1 and said[0].startswith("error: ungm_horizon: a worker process ended in mid-run"), err
+    assert f"the {len(before)} runs finished before it are stored: rerun the same command" in said[0], err
+
+    again = subprocess.run(asked, cwd=PROJECT_ROOT, capture_output=True, text=True, env=env, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"{len(runs) - len(before)} runs computed, {len(before)} already stored" in again.stdout, again.stderr
+    assert {path: path.stat().st_mtime_ns for path in before} == before  # kept as they were, not computed again
+    pd.testing.assert_frame_equal(deterministic_columns(Store(store, "ungm_horizon").load(runs)),
+                                  loky_records(runs, tmp_path, "ungm_horizon"))
+
+
 @pytest.fixture(scope="module")
 def ray_tmpdir():
     """Ray's sessions and its file naming the last cluster started, in a folder of the tests' own (short:

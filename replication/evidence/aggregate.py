@@ -21,7 +21,8 @@ def summarise(records: pd.DataFrame, metric: str, scale: float = 1.0, statistic:
     kind = quantity(metric).scaled(scale)
     variables = [c for c in records.columns if c.startswith(PREFIX)]
     rows = []
-    for (method, condition), group in records.groupby(["method", "condition"], sort=False):
+    read = records[list(dict.fromkeys(["method", "condition", metric, *variables]))]  # not every column copied
+    for (method, condition), group in read.groupby(["method", "condition"], sort=False):
         values = group[metric].astype(float) * scale
         found = estimate(values.to_numpy(), kind, statistic)
         rows.append({

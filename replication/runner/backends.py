@@ -36,16 +36,23 @@ class BackendError(RuntimeError):
     """A parallel backend that cannot be used as configured; the message is meant for the user as is."""
 
 
+class WorkerLost(BackendError):
+    """A worker process ended in mid-run (killed, out of memory, its machine gone) and the backend gave up on
+    its runs; the runs stored before it are kept, and the same command computes the rest."""
+
+
 @dataclass(frozen=True)
 class Backend:
     """A place runs are computed: ``connected(n_jobs, address)`` configures joblib for it (its cluster
     connected) for the duration; ``package``, the import it needs (a cluster's); ``streams``, whether records
-    come back one at a time (ray's joblib backend returns whole lists only); ``clustered``, whether
+    come back one at a time (ray's joblib backend returns whole lists only); ``lost``, the exceptions it
+    raises when a worker process dies in mid-run (imported when asked); ``clustered``, whether
     ``parallel.address`` may name one."""
 
     connected: Callable[[int, str | None], AbstractContextManager]
     package: str | None = None
     streams: bool = True
+    lost: Callable[[], tuple[type[BaseException], ...]] = tuple  # what it raises when a worker dies mid-run
 
     @property
     def clustered(self) -> bool:
@@ -128,7 +135,7 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
         try:
             _answers(address)
         except OSError as error:
-            raise BackendError(f"cannot reach ray at parallel.address={address}: {_one_line(error)}") from None
+            raise BackendError(f"cannot reach ray at parallel.address={address}: {one_line(error)}") from None
     with nullcontext() if address else _ray_on_the_loopback():
         before = lifeline.children()
         try:
@@ -139,7 +146,7 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
         except (ConnectionError, RuntimeError, ValueError) as error:
             where = f"ray at parallel.address={address}" if address else "ray on this machine"
             hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
-            raise BackendError(f"cannot start or reach {where}: {_one_line(error)}{hint}") from None
+            raise BackendError(f"cannot start or reach {where}: {one_line(error)}{hint}") from None
         try:
             node = ray.util.get_node_ip_address()
             if not (address or ipaddress.ip_address(node).is_loopback):
@@ -241,7 +248,7 @@ def _dask_client(address: str | None, n_jobs: int) -> Iterator[None]:
         if cluster is not None:
             cluster.close()
         where = f"the dask scheduler at parallel.address={address}" if address else "a local dask cluster"
-        raise BackendError(f"cannot reach {where}: {_one_line(error)}") from None
+        raise BackendError(f"cannot reach {where}: {one_line(error)}") from None
     try:
         yield
     except BaseException:  # interrupted: stop the local workers now, not once their runs end (a nanny waits 4 s)
@@ -262,14 +269,35 @@ async def _stop_now(cluster) -> None:
 
 
 
-def _one_line(error: BaseException) -> str:
+def one_line(error: BaseException) -> str:
+    """An exception's message on one line (its class's name when it has none)."""
     return " ".join(str(error).split()) or error.__class__.__name__
 
 
+def _loky_lost() -> tuple[type[BaseException], ...]:
+    from joblib.externals.loky.process_executor import TerminatedWorkerError
+
+    return (TerminatedWorkerError,)
+
+
+def _dask_lost() -> tuple[type[BaseException], ...]:
+    """A task whose workers died more often than ``distributed.scheduler.allowed-failures`` (before that, the
+    scheduler sends it to another worker)."""
+    from distributed import KilledWorker
+
+    return (KilledWorker,)
+
+
+def _ray_lost() -> tuple[type[BaseException], ...]:
+    from ray.exceptions import RayActorError, WorkerCrashedError
+
+    return (RayActorError, WorkerCrashedError)
+
+
 BACKENDS: Registry[Backend] = Registry("parallel backend", {
-    "loky": Backend(_loky),
+    "loky": Backend(_loky, lost=_loky_lost),
     "threading": Backend(_threading),
-    "dask": Backend(_dask, package="distributed"),
-    "ray": Backend(_ray, package="ray", streams=False),
+    "dask": Backend(_dask, package="distributed", lost=_dask_lost),
+    "ray": Backend(_ray, package="ray", streams=False, lost=_ray_lost),
 })
 CLUSTER_PACKAGES = {name: b.package for name, b in BACKENDS.items() if b.clustered}  # the import each needs

@@ -23,7 +23,7 @@ import replication
 from replication.condition import Condition
 from replication.errors import RunFailed
 from replication.run import Run
-from replication.runner.backends import BACKENDS, parallel_backend
+from replication.runner.backends import BACKENDS, WorkerLost, one_line, parallel_backend
 from replication.runner.bounds import MANY_RUNS
 from replication.runner.failures import failure
 from replication.runner.memory import one_thread, retain_freed_memory
@@ -169,7 +169,7 @@ def execute(
         return 0
     if progress:
         print(forecast(runs, pending, store, n_jobs), flush=True)
-    by_id = {run.run_id: run for run in pending}
+    by_id, stored = {run.run_id: run for run in pending}, 0
     bar = tqdm(
         total=len(runs),
         initial=len(runs) - len(pending),
@@ -178,14 +178,21 @@ def execute(
         disable=not progress,
         mininterval=1.0,
     )
-    with bar, parallel_backend(backend, n_jobs, address), closing(
-        _records(pending, streamed=BACKENDS[backend].streams)
-    ) as records:
-        for record in records:
-            run = by_id[record["run_id"]]
-            if "failure" in record:
-                store.write_failure(run, record["failure"])
-            else:
-                store.write(run, record)
-            bar.update()
+    lost = BACKENDS[backend].lost()
+    try:
+        with bar, parallel_backend(backend, n_jobs, address), closing(
+            _records(pending, streamed=BACKENDS[backend].streams)
+        ) as records:
+            for record in records:
+                run = by_id[record["run_id"]]
+                if "failure" in record:
+                    store.write_failure(run, record["failure"])
+                else:
+                    store.write(run, record)
+                stored += 1
+                bar.update()
+    except lost as error:
+        raise WorkerLost(f"{runs[0].experiment}: a worker process ended in mid-run and the {backend} backend gave "
+                         f"up on its runs ({error.__class__.__name__}: {one_line(error)}); the {stored} runs "
+                         "finished before it are stored: rerun the same command to compute the rest") from None
     return len(pending)

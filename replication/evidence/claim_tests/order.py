@@ -69,7 +69,8 @@ class Order(ClaimTest):
                         continue
                     allowed = self.spec.tolerance * abs(paired["baseline"].mean())
                     better, worse = paired["method"].to_numpy(), paired["baseline"].to_numpy()
-                    paper = self.effect(a, b, records[records["condition"] == condition].iloc[0], len(paired))
+                    there = records.iloc[np.flatnonzero(records["condition"] == condition)[0]]  # a run's row
+                    paper = self.effect(a, b, there, len(paired))
                     verdict, difference, replication = _order_check(better, worse, kind, scale, allowed, paper)
                     # the line the difference better - worse is tested against: worse by at most the allowance
                     line = allowed * scale * (1 if kind.lower_is_better else -1)

@@ -338,8 +338,10 @@ def pair(records: pd.DataFrame, metric: str, baseline: str, method: str, conditi
     columns = ["data_condition", "repetition", metric]
 
     def at(name: str, where: str | None) -> pd.DataFrame:
-        runs = records[records["method"] == name]
-        return (runs if where is None else runs[runs["condition"] == where])[columns]
+        chosen = records["method"] == name
+        if where is not None:
+            chosen &= records["condition"] == where
+        return records.loc[chosen, columns]  # the three columns taken, not the record's every one
 
     left = at(baseline, baseline_condition or condition)
     right = at(method, condition)
