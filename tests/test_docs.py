@@ -49,6 +49,12 @@ ALLOWED: dict[str, str] = {
     "12 minutes": "README: `make replicate` from a fresh clone with an empty HOME on the 2-core machine, setting "
                   "itself up included, nothing else running (12 min 5 s at 1f7338d, measured 2026-11-29: setup "
                   "80 s, the record's pages 131 s, the quick runs 395 s, their reports 79 s, the checks 41 s)",
+    "8 minutes": "README: `make replicate` from a fresh clone with an empty HOME, nothing else running (7 min 50 s "
+                 "at 87e774a, measured 2026-11-29 04:23: setup 65 s, the record's pages 79 s, the quick runs 250 s, "
+                 "their reports 49 s, the checks 27 s)",
+    "11 minutes": "README: the steps of `make replicate` no change touched (verify, benchmark, calibration page) "
+                  "took 40.5 s at 1f7338d and 27.2 s at 87e774a, both fresh clones on 2026-11-29: 470 s x 40.5 / "
+                  "27.2 = 700 s, the second measurement at the first's speed",
     "10 minutes": "README: `make verify`'s default 200 recorded runs on the 2-core machine, re-computed and the "
                   "verdicts judged again (over 10 minutes, issue 57's new-user test at f29efe1, 2026-11-27)",
     # docs/reproducibility.md, how verify's tolerance was chosen (issue 56), measured 2026-11-27 at b6790c6 on
