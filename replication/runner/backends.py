@@ -19,6 +19,7 @@ import os
 import signal
 import socket
 import threading
+import time
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext
@@ -155,8 +156,20 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
             yield
         finally:
             started = set() if address else lifeline.descendants(lifeline.children() - before)
+            _settle_result_threads(RAY_SHUTDOWN_S)
             ray.shutdown()
             lifeline.end_within(started, RAY_SHUTDOWN_S)  # the agents its raylet starts may outlive it, under load
+
+
+def _settle_result_threads(seconds: float) -> None:
+    """Let ray's pool threads collect their last batches before ray shuts down (after an abort its actors are
+    gone, so each gets its error at once): a thread still waiting then calls ray again, and ray's automatic
+    ``ray.init()`` would start, or join, another cluster on this machine for it, and fail there."""
+    from ray.util.multiprocessing.pool import ResultThread
+
+    deadline = time.monotonic() + seconds
+    for thread in [t for t in threading.enumerate() if isinstance(t, ResultThread)]:
+        thread.join(max(0.0, deadline - time.monotonic()))
 
 
 def _register_ray() -> None:
