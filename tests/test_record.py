@@ -367,8 +367,12 @@ def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsy
 def test_diff_of_two_records_names_them_as_given_and_reads_pages_drawn_from_the_same_record(make_cfg, tmp_path,
                                                                                           monkeypatch, capsys):
     """Where reports/record holds a record's pages as this code draws them, diff reads them; another record's
-    pages are drawn into a scratch folder that is never named (it is gone afterwards), with a bar."""
+    pages are drawn into a scratch folder that is never named (it is gone afterwards), with a bar.  The pages
+    are drawn from this project even by workers a pool started for another one (they keep its environment)."""
+    import os
     import shutil
+
+    from joblib import Parallel, delayed
 
     from replication.paths import HOME_VARIABLE
     from replication.report.__main__ import main as report
@@ -380,8 +384,10 @@ def test_diff_of_two_records_names_them_as_given_and_reads_pages_drawn_from_the_
     manifest = json.loads((tmp_path / "other" / "manifest.json").read_text())
     manifest["experiments"]["gps_qmcpf"]["written"] = "2099-01-01"
     (tmp_path / "other" / "manifest.json").write_text(json.dumps(manifest))
+    monkeypatch.setenv(HOME_VARIABLE, str(tmp_path / "elsewhere"))  # a call for another project starts the
+    Parallel(n_jobs=2)(delayed(os.getenv)(HOME_VARIABLE) for _ in range(2))  # pool (or an earlier test had)
     monkeypatch.setenv(HOME_VARIABLE, str(tmp_path))  # the project: reports/ and record/ in it
-    report(["source=record", "pdf=false", "progress=false"])  # reports/record, drawn from record/
+    report(["source=record", "pdf=false", "progress=false"])  # reports/record, drawn from record/ (on that pool)
     capsys.readouterr()
     diff(["record", "other"])  # the same runs: nothing differs (no exit status 1)
     out, err = capsys.readouterr()

@@ -33,7 +33,7 @@ from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.scorecard import Scorecard
 from replication.evidence.settings import configure
-from replication.paths import CONF_DIR, experiment_names, resolve
+from replication.paths import CONF_DIR, experiment_names, project_at, project_dir, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
 from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
@@ -93,7 +93,7 @@ def main(argv: list[str]) -> None:
         cfg = compose("config", overrides=[o for o in overrides if not o.lstrip("+~").startswith("experiment.")])
     try:  # each experiment's pages on its own worker (the order of the output is the experiments')
         pages = Parallel(n_jobs=cfg.n_jobs, return_as="generator")(
-            delayed(draw)(name, overrides, source, chosen) for name in names)
+            delayed(draw)(name, overrides, source, chosen, project_dir()) for name in names)
         drawn = list(tqdm(pages, total=len(names), desc="pages", unit="experiment", disable=not cfg.progress,
                           mininterval=1.0))
     except ConfigError as error:
@@ -138,12 +138,14 @@ def main(argv: list[str]) -> None:
                 print(f"console: {line}", file=sys.stderr)
 
 
-def draw(name: str, overrides: list[str], source: str, chosen: bool) -> tuple[str, Path | None, int | None, int]:
-    """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``): its name, its
-    page (None where its config is broken and it was not ``chosen`` by name: skipped, and said), and from
-    the record how many of its recorded runs other code made and a multiverse's universes by its design
-    (from the store: None and 0; an experiment has 0 universes)."""
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+def draw(name: str, overrides: list[str], source: str, chosen: bool,
+         home: Path) -> tuple[str, Path | None, int | None, int]:
+    """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``), relative paths
+    taken from the project directory ``home``: its name, its page (None where its config is broken and it was
+    not ``chosen`` by name: skipped, and said), and from the record how many of its recorded runs other code
+    made and a multiverse's universes by its design (from the store: None and 0; an experiment has 0
+    universes)."""
+    with project_at(home), initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         try:
             check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
         except ConfigError as error:
