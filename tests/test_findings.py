@@ -130,12 +130,19 @@ def test_the_readme_part_gives_the_record_size_and_what_each_part_took(tmp_path)
     (tmp_path / "t" / README_TEMPLATE).write_text("{{ record.megabytes }} MB\n{{ parts() }}\n{{ profiled.git_commit }} "
                                                   "{{ profiled_experiments }}\n{{ where_time_goes(false) }}\n"
                                                   "{{ where_time_goes(true) }}\n")
-    pages = render(_drawn(tmp_path), tmp_path / "t")
+    drawn = _drawn(tmp_path)
+    status = json.loads((drawn.folder / "status.json").read_text())
+    status["experiments"]["exp_readings"]["before"] = {"minutes": None, "cpu_minutes": 15.0, "commits": ["abc1234"],
+                                                       "written": "2026-11-01"}  # recorded again, in less time
+    (drawn.folder / "status.json").write_text(json.dumps(status))
+    pages = render(drawn, tmp_path / "t")
     assert set(pages) == {README}  # a part, not a page of its own
     size, *table = pages[README].splitlines()
     assert size == "11.8 MB"
-    assert "| the 1 experiments | 40 |  | 0.04 | 1 min, measured | 2 min, measured |" in table  # 2.5 CPU-minutes
-    assert "| `exp_readings` | 300 | 6 of 17 | 0.16 | 5 min, CPU-hours / 2 |  |" in table
+    assert "| part | runs | universes | CPU-hours | CPU-hours before | on 2 workers | on 2 workers before |" in table
+    # 2.5 CPU-minutes, 4 before
+    assert "| the 1 experiments | 40 |  | 0.04 | 0.07 | 1 min, measured | 2 min, measured |" in table
+    assert "| `exp_readings` | 300 | 6 of 17 | 0.16 | 0.25 | 5 min, CPU-hours / 2 | 8 min, CPU-hours / 2 |" in table
     assert "abcdef123456 1" in table
     # the methods' parts weighted by their CPU (1.5 and 0.5 minutes; C, not profiled, left out): frames
     # (1.5 x 0.2 + 0.5 x 0.6) / 2 = 30 %, the likelihood 0.5 x 0.4 / 2 = 10 %, the filter 1.5 x 0.8 / 2 = 60 %

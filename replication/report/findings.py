@@ -168,14 +168,15 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
         single = [e for e in experiments.values() if not e.get("designed")]
         was = [e.get("before") or e for e in single]  # an experiment recorded once took what it takes
         rows = [[f"the {len(single)} experiments", number(sum(e["runs"] for e in single)), "",
-                 number(round(sum(e["cpu_minutes"] for e in single) / 60, 2)),
-                 f"{duration(sum(e['minutes'] or 0 for e in single))}, measured",
-                 f"{duration(sum(e['minutes'] or 0 for e in was))}, measured" if was != single else ""]]
+                 *(number(round(sum(e["cpu_minutes"] for e in parts) / 60, 2)) for parts in (single, was)),
+                 *(f"{duration(sum(e['minutes'] or 0 for e in parts))}, measured" for parts in (single, was))]]
         rows += [[f"`{name}`", number(e["runs"]), f"{e['universes']} of {e['designed']}",
-                  number(round(e["cpu_minutes"] / 60, 2)), f"{duration(e['cpu_minutes'] / 2)}, CPU-hours / 2",
-                  f"{duration(e['before']['cpu_minutes'] / 2)}, CPU-hours / 2" if e.get("before") else ""]
+                  *(number(round(part["cpu_minutes"] / 60, 2)) if part else "" for part in (e, e.get("before"))),
+                  *(f"{duration(part['cpu_minutes'] / 2)}, CPU-hours / 2" if part else ""
+                    for part in (e, e.get("before")))]
                  for name, e in experiments.items() if e.get("designed")]
-        return markdown_table(["part", "runs", "universes", "CPU-hours", "on 2 workers", "before"], rows)
+        return markdown_table(["part", "runs", "universes", "CPU-hours", "CPU-hours before", "on 2 workers",
+                               "on 2 workers before"], rows)
 
     def where_time_goes(by_method: bool) -> str:
         if not profile:
