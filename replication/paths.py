@@ -8,8 +8,6 @@ The command line fixes ``REPLICATION_HOME`` at start, so its workers and compani
 """
 
 import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 PACKAGE_DIR = Path(__file__).resolve().parent
@@ -20,21 +18,6 @@ HOME_VARIABLE = "REPLICATION_HOME"
 def project_dir() -> Path:
     """``$REPLICATION_HOME`` if set, else the working directory."""
     return Path(os.environ.get(HOME_VARIABLE) or os.getcwd()).resolve()
-
-
-@contextmanager
-def project_at(home: Path) -> Iterator[None]:
-    """Relative paths taken from ``home`` inside the block, as the process that handed this one its work takes
-    them: a pool's worker, started for an earlier call, keeps the environment it was started with."""
-    before = os.environ.get(HOME_VARIABLE)
-    os.environ[HOME_VARIABLE] = str(home)
-    try:
-        yield
-    finally:
-        if before is None:
-            del os.environ[HOME_VARIABLE]
-        else:
-            os.environ[HOME_VARIABLE] = before
 
 
 def resolve(path: str | Path) -> Path:

@@ -18,8 +18,11 @@ view of the index as ``reports/screenshot.png`` (where Chromium is installed).
 A bar counts the experiments drawn (``progress=false`` hides it).
 """
 
+import os
 import shutil
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +36,7 @@ from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.scorecard import Scorecard
 from replication.evidence.settings import configure
-from replication.paths import CONF_DIR, experiment_names, project_at, project_dir, resolve
+from replication.paths import CONF_DIR, HOME_VARIABLE, experiment_names, project_dir, resolve
 from replication.record.manifest import MANIFEST, PAGES, Manifest, read_profile
 from replication.record.layer import beneath, reader, universes_beneath
 from replication.record.runs import Record
@@ -138,6 +141,22 @@ def main(argv: list[str]) -> None:
                 print(f"console: {line}", file=sys.stderr)
 
 
+@contextmanager
+def _project_at(home: Path) -> Iterator[None]:
+    """Relative paths taken from ``home`` inside the block, as the process that handed this one its work takes
+    them: a pool's worker, started for an earlier call, keeps the environment it was started with.  (Here, not
+    in :mod:`replication.paths`: the runs' code imports that module, and its bytes are in their keys.)"""
+    before = os.environ.get(HOME_VARIABLE)
+    os.environ[HOME_VARIABLE] = str(home)
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ[HOME_VARIABLE]
+        else:
+            os.environ[HOME_VARIABLE] = before
+
+
 def draw(name: str, overrides: list[str], source: str, chosen: bool,
          home: Path) -> tuple[str, Path | None, int | None, int]:
     """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``), relative paths
@@ -145,7 +164,7 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool,
     not ``chosen`` by name: skipped, and said), and from the record how many of its recorded runs other code
     made and a multiverse's universes by its design (from the store: None and 0; an experiment has 0
     universes)."""
-    with project_at(home), initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+    with _project_at(home), initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         try:
             check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
         except ConfigError as error:
