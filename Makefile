@@ -1,7 +1,8 @@
 # make replicate   set up, run every experiment at SCALE (quick by default), write reports/index.html
 # make pdf         reports/replication.pdf: the scorecard, tables and figures of every report drawn (after make replicate)
-# make test        set up and run the test suite on JOBS (2) workers (the long paper-scale runs are marked slow and skipped)
-# make test-fast   the inner loop: the suite without the end-to-end tests (marked e2e: subprocesses, clusters)
+# make test        set up and run the test suite on JOBS (2) workers, but its end-to-end tests and the long
+#                  paper-scale runs (marked e2e and slow)
+# make test-e2e    the end-to-end tests (marked e2e: subprocesses, killed runners, clusters); CI runs both
 # make report      redraw every report from the stored runs, running nothing
 # make benchmark   time the SMC core on this machine, and against particles, Stone Soup and filterpy, each in its own venv under .peers/ (reports/benchmark/)
 #                  (where one run's time goes: python benchmarks/profile_run.py EXPERIMENT METHOD [TEXT] [--scale paper])
@@ -37,7 +38,7 @@ comma := ,
 empty :=
 space := $(empty) $(empty)
 
-.PHONY: setup browser test test-fast test-all replicate pdf readings report benchmark docs calibrate record verify findings
+.PHONY: setup browser test test-e2e test-all replicate pdf readings report benchmark docs calibrate record verify findings
 
 setup: $(VENV)/.installed
 
@@ -59,10 +60,10 @@ browser:
 		|| echo "chromium not installed: the headless-browser report test will be skipped"
 
 test: setup browser
-	$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadgroup --durations=25
+	$(BIN)/python -m pytest -m "not slow and not e2e" -n $(JOBS) --dist loadgroup --durations=15
 
-test-fast: setup
-	$(BIN)/python -m pytest -m "not slow and not e2e" -n $(JOBS) --dist loadgroup
+test-e2e: setup browser
+	$(BIN)/python -m pytest -m "e2e and not slow" -n $(JOBS) --dist loadgroup --durations=15
 
 test-all: setup browser
 	$(BIN)/python -m pytest -n $(JOBS) --dist loadgroup

@@ -305,7 +305,7 @@ def test_the_intact_copy_passes(tmp_path):
     assert np.isfinite(sequence.truth).all()
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_users_own_sequences_get_their_own_report_and_leave_the_scorecard_alone(cli, tmp_path):
     """``data.otb=<folder> sequences=[...]`` on a copy of a shipped sequence under another name: the
     experiment's methods on it alone, reported as hspf@mine with what differs, no companion run, and
@@ -347,7 +347,7 @@ def test_every_shipped_experiment_passes_the_preflight(tmp_path):
                 preflight(cfg, written)
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_alone(cli, tmp_path):
     """bis_pf_pets with another MOTChallenge sequence in the PETS scene's place: reported as bis_pf_pets@campus,
     the bis_pf.pets and bis_pf.cost rows (and every other) of claims.csv byte-identical."""
@@ -369,7 +369,7 @@ def test_a_users_own_mot_sequence_gets_its_own_report_and_leaves_the_scorecard_a
     assert not (tmp_path / "reports" / "quick" / "bis_pf_pets").exists()
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_sequences_of_ones_own_run_through_a_mot_experiment_and_its_figures_follow_them(cli, tmp_path):
     """``data.mot=<folder> sequences=[...]`` with bis_pf_pets: the runs are on the user's MOTChallenge sequence
     alone (a copy of TUD-Campus under another name), its snapshots and identity timeline drawn for it, and

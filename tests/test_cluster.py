@@ -29,7 +29,7 @@ from replication.runner.store import Store
 TINY = ("scale=quick", "experiment.runs.quick=2")
 
 
-# clusters and subprocesses: make test-fast leaves them out; one xdist worker runs them all (make test's
+# clusters and subprocesses: make test-e2e runs them, make test does not; one xdist worker runs them all (make test's
 # --dist loadgroup), so two ray heads or dask clusters never start at once
 pytestmark = [pytest.mark.e2e, pytest.mark.xdist_group("clusters")]
 

@@ -38,7 +38,7 @@ def test_a_run_stopped_by_nan_log_weights_fails_with_the_reason(make_cfg):
         "run_id": run.run_id, "failure": "log-weights contain NaN or +inf"}
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_failed_runs_are_recorded_counted_and_not_rerun(cli, tmp_path):
     """A variance so large that the grid filter's posterior overflows to NaN: its runs fail, the others
     are stored; the command says so and exits 3, the report counts them, a rerun computes nothing."""

@@ -22,7 +22,7 @@ STRINGS = {
 }
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 @pytest.mark.skipif(browser() is None, reason="no Chromium on the PATH (make test installs it as root with apt)")
 def test_markup_from_a_config_never_runs_in_the_report(tmp_path):
     overrides = [f"{key}='{value}'" for key, value in STRINGS.items()]

@@ -124,7 +124,7 @@ def _lowest(name: str, floor: str, python: Path) -> str:
 @pytest.mark.e2e
 def test_the_declared_floors_pass_the_fast_tests(tmp_path):
     """Every dependency at the lowest version pyproject.toml allows (its own, the cluster extra's and the test
-    extra's), in a fresh venv, passes the tests ``make test`` runs: a floor that lies fails here.  Twenty
+    extra's), in a fresh venv, passes the tests ``make test`` and ``make test-e2e`` run: a floor that lies fails here.  Twenty
     minutes and the network: ``-m slow``."""
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)

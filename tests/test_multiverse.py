@@ -306,7 +306,7 @@ def test_a_choice_that_leaves_the_runs_as_they_are_has_no_effect_exactly():
     assert effect is None and np.isnan(p)
 
 
-@pytest.mark.e2e  # a subprocess: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess: make test-e2e runs it, make test does not
 def test_the_command_runs_a_multiverse_universe_by_universe(cli, tmp_path):
     """Every experiment's runs of one universe are stored before the next universe starts, the default
     first: a multiverse stopped part-way (a session's end) leaves whole universes, which the record takes

@@ -69,7 +69,7 @@ def test_the_runs_the_record_holds_are_read_from_it_and_only_the_rest_computed(m
     assert error.count("\n") == 1 and f"{path} does not have the SHA-256" in error, error
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_paper_scale_request_for_a_recorded_experiment_computes_nothing_and_says_so(recorded, tmp_path):
     command = [sys.executable, "-c", NOTHING_COMPUTED, "experiment=hspf_ungm", f"record={tmp_path / 'record'}",
                f"store={tmp_path / 'experiments'}", f"reports={tmp_path / 'reports'}", "outside_project=true",

@@ -126,7 +126,7 @@ def assert_all_end(pids: set[int], within: float = 5.0) -> None:
 NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table in /proc")
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 @NEEDS_PROC
 def test_a_request_says_its_size_and_rough_duration_before_it_starts(make_cfg, tmp_path):
     """How many runs, how many to compute, and about how long: the stored runs' wall times of each method and
@@ -261,7 +261,7 @@ def test_sigint_sigterm_and_sigkill_at_random_moments_resume_to_the_same_table(m
                                   deterministic_columns(reference.load(runs).drop(columns=typed)))
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 @NEEDS_PROC
 @pytest.mark.parametrize(
     "experiment, args",
@@ -304,7 +304,7 @@ def test_local_workers_leave_ctrl_c_to_the_parent(backend):
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the parent still gets Ctrl-C
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_two_processes_writing_one_store_leave_one_record_per_run(make_cfg, tmp_path):
     runs = expand(make_cfg("hspf_ungm", *TINY))
     reference = Store(tmp_path / "reference", "hspf_ungm")

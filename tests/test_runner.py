@@ -72,7 +72,7 @@ def test_hydra_flags_describe_the_app_without_an_experiment(args, expected):
     assert len(result.stdout.splitlines()) < 60
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_users_own_experiment_runs_from_hydras_config_dir(cli, tmp_path):
     """``--config-dir`` (Hydra's way to add configs) makes a user's ``experiment/<name>.yaml`` known."""
     own = tmp_path / "my_conf" / "experiment"
@@ -193,7 +193,7 @@ def test_code_digest_leaves_out_the_modules_that_only_read_runs(tmp_path):
     assert digest("readers", "export.py", "report/render.py") == before != digest("metric", "metrics/tracking.py")
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_changed_code_lands_in_new_runs(tmp_path):
     """A copy of the project whose bootstrap filter differs by one comment recomputes the bootstrap PF's
     runs and no other; a change to the report layer, the command line or the reader of records reuses them.
@@ -256,7 +256,7 @@ def test_stored_files_are_created_as_open_creates_them(tmp_path, make_cfg, umask
     assert {stat.S_IMODE(p.stat().st_mode) for p in (store.path(first), store.failure_path(second))} == {mode}
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_interrupted_job_resumes_to_the_same_table(tmp_path):
     """Kill a real run part-way (SIGKILL: no clean-up), resume it, compare with an uninterrupted run."""
     args = ["experiment=ungm_horizon", "scale=quick", "experiment.runs.quick=6", "n_jobs=2", "progress=false"]
@@ -288,7 +288,7 @@ def test_interrupted_job_resumes_to_the_same_table(tmp_path):
     pd.testing.assert_frame_equal(table(tmp_path / "a"), table(tmp_path / "b"))
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_cli_end_to_end_writes_report(cli, tmp_path):
     result = cli("experiment=gps_qmcpf", "experiment.also=[]", *SMALL)  # not its helicopter half
     assert result.returncode == 0, result.stderr
@@ -302,7 +302,7 @@ def test_cli_end_to_end_writes_report(cli, tmp_path):
     assert "0 runs computed, 48 already stored" in again.stdout
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_paper_experiment_runs_its_companions_with_the_shared_settings(cli, tmp_path):
     """``also:`` runs the paper's other half with the same scale and store, not the parent's own overrides."""
     result = cli("experiment=hspf_ungm", "+experiment.also=[ungm_horizon]", "experiment.runs.quick=2", "scale=quick")
@@ -324,7 +324,7 @@ def test_workers_keep_freed_memory_on_glibc():
     assert retain_freed_memory() is True
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_path):
     """``-m key=a,b`` stores every value's runs (shared runs once); ``replication.report sweep=`` reads them back."""
     settings = ["scale=quick", "experiment.runs.quick=3", "experiment.model.sweep.steps=[10]"]
@@ -356,7 +356,7 @@ def test_a_multirun_sweep_goes_through_the_store_and_is_drawn_from_it(cli, tmp_p
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "metric 'nope'" in bad.stderr
 
 
-@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-fast leaves it out
+@pytest.mark.e2e  # a subprocess, a killed runner or a cluster: make test-e2e runs it, make test does not
 def test_a_multirun_draws_its_sweep_at_its_end(cli, tmp_path):
     """The Hydra callback draws the sweep of one setting when the multirun ends: no retyping."""
     result = cli("-m", "experiment=hspf_ungm", "scale=quick", "experiment.runs.quick=5", "experiment.methods.grid.n_points=201",
@@ -397,7 +397,7 @@ def test_a_table_whose_scene_is_not_run_is_named_before_any_work(make_cfg):
     assert not [line for line in everything if "table" in line]
 
 
-@pytest.mark.e2e  # subprocesses: make test-fast leaves it out
+@pytest.mark.e2e  # subprocesses: make test-e2e runs it, make test does not
 def test_runs_stored_without_a_report_are_drawn_later_as_if_drawn_as_they_went(cli, tmp_path):
     """``draw=false`` (make replicate's runs) computes and stores the runs and draws nothing; the report
     command then draws the page and summary that drawing as the runs go gives (from the same stored runs)."""

@@ -144,7 +144,7 @@ def test_every_recorded_run_holds_its_declared_types_and_ranges():
     assert checked > 1_000_000
 
 
-@pytest.mark.e2e  # subprocesses: make test-fast leaves it out
+@pytest.mark.e2e  # subprocesses: make test-e2e runs it, make test does not
 def test_abc_in_a_record_is_one_line_in_report_and_run(stored, tmp_path):
     """``"rmse": "abc"`` in one record: ``pf-replicate report`` draws without it and names the file in one
     line; the run command names it in one line, sets it aside and computes that run again."""
