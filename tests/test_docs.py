@@ -39,24 +39,21 @@ ALLOWED: dict[str, str] = {
     "3.11": "the Python version the project needs",
     "5.52": "bis_pf's own frame rate for 36 targets, quoted in its text (Experiment 3) beside Table 1: a paper's "
             "number, as published_values.csv's cells are, that never goes stale",
-    "7 minutes": "README: `make test` from a fresh clone with an empty HOME on the 2-core machine, creating "
-                 "the venv included (6 min 56 s at 161a222, measured 2026-11-26)",
-    "21 minutes": "README: `bash .ci/run` (make test) from a fresh clone with an empty HOME on the 2-core machine "
-                  "while its reference work ran 4-5 times slower than on 2026-11-26 (21 min 5 s at 7b2d924, "
-                  "measured 2026-11-28)",
-    "9 minutes": "README: `make replicate` at the quick scale right after `make test`, same machine "
-                 "(8 min 29 s at 161a222, measured 2026-11-26)",
     "12 minutes": "README: `make replicate` from a fresh clone with an empty HOME on the 2-core machine, setting "
                   "itself up included, nothing else running (12 min 5 s at 1f7338d, measured 2026-11-29: setup "
                   "80 s, the record's pages 131 s, the quick runs 395 s, their reports 79 s, the checks 41 s)",
     "8 minutes": "README: `make replicate` from a fresh clone with an empty HOME, nothing else running (7 min 50 s "
                  "at 87e774a, measured 2026-11-29 04:23: setup 65 s, the record's pages 79 s, the quick runs 250 s, "
-                 "their reports 49 s, the checks 27 s)",
+                 "their reports 49 s, the checks 27 s); and `make test` in `bash .ci/run` from a fresh clone with "
+                 "an empty HOME, nothing else running (about 8 min at fec4986, 2026-11-29 08:00: .ci/run took "
+                 "1082 s, of which make test-e2e's pytest 594 s; make test's pytest 413 s)",
     "11 minutes": "README: the steps of `make replicate` no change touched (verify, benchmark, calibration page) "
                   "took 40.5 s at 1f7338d and 27.2 s at 87e774a, both fresh clones on 2026-11-29: 470 s x 40.5 / "
                   "27.2 = 700 s, the second measurement at the first's speed",
     "10 minutes": "README: `make verify`'s default 200 recorded runs on the 2-core machine, re-computed and the "
-                  "verdicts judged again (over 10 minutes, issue 57's new-user test at f29efe1, 2026-11-27)",
+                  "verdicts judged again (over 10 minutes, issue 57's new-user test at f29efe1, 2026-11-27); and "
+                  "`make test-e2e` after `make test` in the same .ci/run (its pytest 9 min 54 s at fec4986, "
+                  "2026-11-29)",
     # docs/reproducibility.md, how verify's tolerance was chosen (issue 56), measured 2026-11-27 at b6790c6 on
     # the 2-core AMD EPYC (family 25, model 1): the largest relative difference of a score ...
     "1.8e-14": "... between 75 quick runs as they are and with OpenBLAS's kernel masked (OPENBLAS_CORETYPE)",
