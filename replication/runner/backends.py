@@ -143,7 +143,10 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
             with _sigterm_kept(), warnings.catch_warnings():
                 warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
                 ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
-                         **({} if address else {"include_dashboard": False}))  # the runner never reads it
+                         **({} if address else {"include_dashboard": False,  # the runner never reads it
+                                                # ray's workers at nice 15 get a few per cent of a core
+                                                # beside any other busy process: a run's own priority
+                                                "_system_config": {"worker_niceness": 0}}))
         except (ConnectionError, RuntimeError, ValueError) as error:
             where = f"ray at parallel.address={address}" if address else "ray on this machine"
             hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""

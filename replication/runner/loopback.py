@@ -15,6 +15,7 @@ from contextlib import contextmanager
 
 QUIET = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
 START_S = 120.0  # a cluster that has not come up within this is reported, not waited for
+NICENESS = "RAY_worker_niceness"  # the nice value ray starts its workers at (15 unless set)
 
 
 def free_port() -> int:
@@ -61,7 +62,10 @@ def dask_cluster(workers: int) -> Iterator[str]:
 def ray_cluster(workers: int, env: Mapping[str, str] | None = None) -> Iterator[str]:
     """``ray start --head --num-cpus=workers --block`` under ``env`` (this process's environment if None;
     the processes that join the head need the same ``RAY_AUTH_TOKEN`` and ``RAY_TMPDIR``); yields its
-    address once ``ray status`` answers.  Ending the blocking head stops every process it started."""
+    address once ``ray status`` answers.  Ending the blocking head stops every process it started.  Its
+    workers run at the priority of other work (``RAY_worker_niceness=0``): ray's default, nice 15, leaves
+    them a few per cent of a core beside any other busy process."""
+    env = {**(os.environ if env is None else env), NICENESS: "0"}
     port = free_port()
     address = f"127.0.0.1:{port}"
     head = subprocess.Popen([command_line("ray"), "start", "--head", f"--port={port}", f"--num-cpus={workers}",
