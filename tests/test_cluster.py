@@ -401,20 +401,41 @@ def loopback(address: str) -> bool:
 
 @NEEDS_PROC
 @pytest.mark.parametrize("backend", ["dask", "ray"])
-def test_a_local_cluster_listens_on_the_loopback_alone(tmp_path, backend, request):
+def test_a_local_cluster_listens_on_the_loopback_alone_and_runs_at_the_runners_priority(tmp_path, backend,
+                                                                                       request):
     """Every socket the run's processes (the runner, its cluster's scheduler or GCS, raylet and agents, every
     worker) listen on, sampled while it runs, is on 127.0.0.0/8 or ::1: nothing on another interface, nor
-    on all of them (0.0.0.0, ::)."""
+    on all of them (0.0.0.0, ::).  And every one of them runs at the runner's nice value: ray starts its
+    workers at nice 15 unless told, where beside any other busy process they get a few per cent of a core
+    (a ray test of the killed worker hung past its timeout so beside the record's rebuild)."""
     pytest.importorskip("psutil", reason="psutil is not installed (distributed's own dependency)")
     env = local_backend_env(backend, request)
     runner = subprocess.Popen(
         command("hspf_ungm", tmp_path / "store", tmp_path / "reports", *TINY, "n_jobs=2", f"parallel.backend={backend}"),
         cwd=PROJECT_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
-    seen, deadline = set(), time.monotonic() + 600
+    seen, nice, deadline = set(), {}, time.monotonic() + 600
     while runner.poll() is None and time.monotonic() < deadline:
-        seen |= listening({runner.pid} | descendants(runner.pid))
+        started = descendants(runner.pid)
+        seen |= listening({runner.pid} | started)
+        nice |= niceness(started)
         time.sleep(0.2)
     _, err = runner.communicate(timeout=60)
     assert runner.returncode == 0, err
     assert seen, "no listening socket seen: the cluster was not sampled"
     assert {address for address, *_ in seen if not loopback(address)} == set(), sorted(seen)
+    assert any(WORKERS[backend] in line for line, _ in nice.values()), nice  # its workers were sampled
+    assert {pid: seen for pid, seen in nice.items() if seen[1] != os.nice(0)} == {}
+
+
+WORKERS = {"dask": "multiprocessing.spawn", "ray": "ray::"}  # in the command line of each cluster's workers
+
+
+def niceness(pids: set[int]) -> dict[int, tuple[str, int]]:
+    """The command line and nice value of each of ``pids`` still running."""
+    found = {}
+    for pid in pids:
+        try:
+            found[pid] = cmdline(pid)[:160], os.getpriority(os.PRIO_PROCESS, pid)
+        except ProcessLookupError:  # ended meanwhile
+            pass
+    return found

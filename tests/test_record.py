@@ -341,12 +341,8 @@ def test_every_recorded_run_is_the_one_this_code_would_make():
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         for name in sorted(manifest.experiments):
             cfg = compose("config", overrides=[f"experiment={name}", "scale=paper"])
-            if "multiverse" not in cfg.experiment:
-                stale[name] = len(record.stale(expand(cfg)))
-                continue
-            multiverse = load(cfg)
-            stale[name] = sum(len(record.universe(name, u.name).stale(multiverse.runs[u.name, e]))
-                              for u in multiverse.universes for e in multiverse.experiments)
+            multiverse = "multiverse" in cfg.experiment
+            stale[name] = record.stale_universes(load(cfg)) if multiverse else len(record.stale(expand(cfg)))
     assert {name: n for name, n in stale.items() if n and name not in REBUILDING} == {}, \
         "run code changed: rebuild these parts of the record"
     assert all(stale.get(name) for name in REBUILDING), "rebuilt (or dropped): take it out of REBUILDING"

@@ -163,6 +163,12 @@ class Record:
         the run's): the record shows what that code computed, not what this code would."""
         return [run for run, found in self.found(runs) if found["run_key"] != run.key]
 
+    def stale_universes(self, multiverse) -> int:
+        """How many of ``multiverse``'s recorded runs, over all its universes, other code or settings made
+        (:meth:`stale`)."""
+        return sum(len(self.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
+                   for u in multiverse.universes for e in multiverse.experiments)
+
 
 def universe_path(root: Path, multiverse: str, universe: str) -> Path:
     """``<root>/<multiverse>/universes/<universe>.parquet``, the universe's name made a file name

@@ -18,11 +18,8 @@ view of the index as ``reports/screenshot.png`` (where Chromium is installed).
 A bar counts the experiments drawn (``progress=false`` hides it).
 """
 
-import os
 import shutil
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,6 +29,7 @@ from tqdm.auto import tqdm
 
 from replication import atomic
 from replication.arguments import read
+from replication.environment import variables
 from replication.errors import ConfigError, fail
 from replication.evidence.published import published_path
 from replication.evidence.scorecard import Scorecard
@@ -141,22 +139,6 @@ def main(argv: list[str]) -> None:
                 print(f"console: {line}", file=sys.stderr)
 
 
-@contextmanager
-def _project_at(home: Path) -> Iterator[None]:
-    """Relative paths taken from ``home`` inside the block, as the process that handed this one its work takes
-    them: a pool's worker, started for an earlier call, keeps the environment it was started with.  (Here, not
-    in :mod:`replication.paths`: the runs' code imports that module, and its bytes are in their keys.)"""
-    before = os.environ.get(HOME_VARIABLE)
-    os.environ[HOME_VARIABLE] = str(home)
-    try:
-        yield
-    finally:
-        if before is None:
-            del os.environ[HOME_VARIABLE]
-        else:
-            os.environ[HOME_VARIABLE] = before
-
-
 def draw(name: str, overrides: list[str], source: str, chosen: bool,
          home: Path) -> tuple[str, Path | None, int | None, int]:
     """Experiment (or multiverse) ``name``'s pages, from the store or the record (``source``), relative paths
@@ -164,7 +146,10 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool,
     not ``chosen`` by name: skipped, and said), and from the record how many of its recorded runs other code
     made and a multiverse's universes by its design (from the store: None and 0; an experiment has 0
     universes)."""
-    with _project_at(home), initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+    # a pool's worker, started for an earlier call, keeps the environment it was started with: relative paths
+    # taken from ``home`` as the caller takes them
+    with (variables({HOME_VARIABLE: str(home)}),
+          initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3")):
         try:
             check_yaml(CONF_DIR / "experiment" / f"{name}.yaml")
         except ConfigError as error:
@@ -178,9 +163,7 @@ def draw(name: str, overrides: list[str], source: str, chosen: bool,
             multiverse, record = load_multiverse(cfg), Record(resolve(cfg.record))
             page = write_multiverse(cfg, multiverse, tuple(overrides),
                                     lambda name, u: record.universe(multiverse.name, u.name))
-            return name, page, sum(len(record.universe(multiverse.name, u.name).stale(multiverse.runs[u.name, e]))
-                                   for u in multiverse.universes for e in multiverse.experiments), \
-                len(multiverse.universes)
+            return name, page, record.stale_universes(multiverse), len(multiverse.universes)
         if "multiverse" in cfg.experiment:  # a paper's readings: every universe's stored runs (at paper scale,
             multiverse = load_multiverse(cfg)  # the record's beneath them, as the run read them)
             return name, write_multiverse(cfg, multiverse, tuple(overrides),

@@ -166,14 +166,22 @@ def context(drawn: Drawn, paper: str, papers: dict[str, Paper]) -> dict:
     def parts() -> str:
         experiments = status["experiments"]
         single = [e for e in experiments.values() if not e.get("designed")]
-        was = [e.get("before") or e for e in single]  # an experiment recorded once took what it takes
-        rows = [[f"the {len(single)} experiments", number(sum(e["runs"] for e in single)), "",
-                 *(number(round(sum(e["cpu_minutes"] for e in parts) / 60, 2)) for parts in (single, was)),
-                 *(f"{duration(sum(e['minutes'] or 0 for e in parts))}, measured" for parts in (single, was))]]
-        rows += [[f"`{name}`", number(e["runs"]), f"{e['universes']} of {e['designed']}",
-                  *(number(round(part["cpu_minutes"] / 60, 2)) if part else "" for part in (e, e.get("before"))),
-                  *(f"{duration(part['cpu_minutes'] / 2)}, CPU-hours / 2" if part else ""
-                    for part in (e, e.get("before")))]
+
+        def took(recorded: list[dict]) -> tuple[str, str]:  # the experiments: CPU-hours, and their wall measured
+            return (number(round(sum(e["cpu_minutes"] for e in recorded) / 60, 2)),
+                    f"{duration(sum(e['minutes'] or 0 for e in recorded))}, measured")
+
+        def spread(part: dict | None) -> tuple[str, str]:  # a multiverse: CPU-hours, and them on 2 workers
+            return (number(round(part["cpu_minutes"] / 60, 2)), f"{duration(part['cpu_minutes'] / 2)}, CPU-hours / 2") \
+                if part else ("", "")
+
+        def row(part: str, runs: int, universes: str, now: tuple[str, str], before: tuple[str, str]) -> list[str]:
+            return [part, number(runs), universes, now[0], before[0], now[1], before[1]]
+
+        # an experiment recorded once took what it takes
+        rows = [row(f"the {len(single)} experiments", sum(e["runs"] for e in single), "", took(single),
+                    took([e.get("before") or e for e in single]))]
+        rows += [row(f"`{name}`", e["runs"], f"{e['universes']} of {e['designed']}", spread(e), spread(e.get("before")))
                  for name, e in experiments.items() if e.get("designed")]
         return markdown_table(["part", "runs", "universes", "CPU-hours", "CPU-hours before", "on 2 workers",
                                "on 2 workers before"], rows)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 from joblib import parallel_config, register_parallel_backend
 
+from replication.environment import variables
 from replication.kinds import Registry
 from replication.runner import lifeline
 
@@ -125,7 +126,7 @@ def _answers(address: str, seconds: float = 10.0) -> None:
 def _ray_cluster(address: str | None) -> Iterator[None]:
     """ray connected for the duration, and shut down after if it was started here: the cluster at ``address``
     (first checked to answer), or, with no address, a new local cluster on the loopback alone
-    (:func:`_ray_on_the_loopback`), never one named by ``RAY_ADDRESS`` or by a file a past one left."""
+    (:func:`_local_ray_cluster`), never one named by ``RAY_ADDRESS`` or by a file a past one left."""
     import ray
 
     _register_ray()
@@ -137,16 +138,13 @@ def _ray_cluster(address: str | None) -> Iterator[None]:
             _answers(address)
         except OSError as error:
             raise BackendError(f"cannot reach ray at parallel.address={address}: {one_line(error)}") from None
-    with nullcontext() if address else _ray_on_the_loopback():
+    with nullcontext() if address else _local_ray_cluster():
         before = lifeline.children()
         try:
             with _sigterm_kept(), warnings.catch_warnings():
                 warnings.filterwarnings("ignore", category=FutureWarning, module=r"ray\.")  # ray's tips, each start
                 ray.init(address=address or "local", log_to_driver=False, logging_level=logging.ERROR,
-                         **({} if address else {"include_dashboard": False,  # the runner never reads it
-                                                # ray's workers at nice 15 get a few per cent of a core
-                                                # beside any other busy process: a run's own priority
-                                                "_system_config": {"worker_niceness": 0}}))
+                         **({} if address else {"include_dashboard": False}))  # the runner never reads it
         except (ConnectionError, RuntimeError, ValueError) as error:
             where = f"ray at parallel.address={address}" if address else "ray on this machine"
             hint = " (a cluster with token authentication also needs RAY_AUTH_MODE=token here)" if address else ""
@@ -190,28 +188,28 @@ def _register_ray() -> None:
 
 RAY_SHUTDOWN_S = 5.0  # after ray.shutdown(), the seconds a local cluster's processes have to end before SIGKILL
 RAY_LOCAL_ONLY = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # "0": ray without clusters, its node on the loopback
+AT_NORMAL_PRIORITY = {"RAY_worker_niceness": "0"}  # ray's workers at its default nice 15 get a few per cent of
+#                                                    a core beside any other busy process
 
 
 @contextmanager
-def _ray_on_the_loopback() -> Iterator[None]:
+def _local_ray_cluster() -> Iterator[None]:
     """While it lasts, a local ray cluster takes the loopback (127.0.0.1) for its node's address, and every
     service it starts (GCS, raylet, object manager, workers, agents) listens there alone, as a local dask
-    cluster does.  On Linux ray takes the machine's own address instead and listens on every interface; it
-    takes the loopback where clusters of several machines are not enabled (:data:`RAY_LOCAL_ONLY` ``=0``,
-    macOS's and Windows's default).  The processes ray starts read that variable from their environment;
-    this process read it once, when ray was imported, into the constant set here too."""
+    cluster does; and it starts its workers at the priority of other work (:data:`AT_NORMAL_PRIORITY`).  On
+    Linux ray takes the machine's own address instead and listens on every interface; it takes the loopback
+    where clusters of several machines are not enabled (:data:`RAY_LOCAL_ONLY` ``=0``, macOS's and Windows's
+    default).  The processes ray starts read both from their environment; this process read the first once,
+    when ray was imported, into the constant set here too."""
     from ray._private import ray_constants
 
-    saved = os.environ.get(RAY_LOCAL_ONLY), ray_constants.ENABLE_RAY_CLUSTER
-    os.environ[RAY_LOCAL_ONLY], ray_constants.ENABLE_RAY_CLUSTER = "0", False
+    saved = ray_constants.ENABLE_RAY_CLUSTER
+    ray_constants.ENABLE_RAY_CLUSTER = False
     try:
-        yield
+        with variables({RAY_LOCAL_ONLY: "0", **AT_NORMAL_PRIORITY}):
+            yield
     finally:
-        ray_constants.ENABLE_RAY_CLUSTER = saved[1]
-        if saved[0] is None:
-            os.environ.pop(RAY_LOCAL_ONLY, None)
-        else:
-            os.environ[RAY_LOCAL_ONLY] = saved[0]
+        ray_constants.ENABLE_RAY_CLUSTER = saved
 
 
 @contextmanager

@@ -13,9 +13,10 @@ import time
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 
+from replication.runner.backends import AT_NORMAL_PRIORITY
+
 QUIET = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
 START_S = 120.0  # a cluster that has not come up within this is reported, not waited for
-NICENESS = "RAY_worker_niceness"  # the nice value ray starts its workers at (15 unless set)
 
 
 def free_port() -> int:
@@ -63,9 +64,9 @@ def ray_cluster(workers: int, env: Mapping[str, str] | None = None) -> Iterator[
     """``ray start --head --num-cpus=workers --block`` under ``env`` (this process's environment if None;
     the processes that join the head need the same ``RAY_AUTH_TOKEN`` and ``RAY_TMPDIR``); yields its
     address once ``ray status`` answers.  Ending the blocking head stops every process it started.  Its
-    workers run at the priority of other work (``RAY_worker_niceness=0``): ray's default, nice 15, leaves
-    them a few per cent of a core beside any other busy process."""
-    env = {**(os.environ if env is None else env), NICENESS: "0"}
+    workers run at the priority of other work, as the runner's own local cluster's do
+    (:data:`~replication.runner.backends.AT_NORMAL_PRIORITY`)."""
+    env = {**(os.environ if env is None else env), **AT_NORMAL_PRIORITY}
     port = free_port()
     address = f"127.0.0.1:{port}"
     head = subprocess.Popen([command_line("ray"), "start", "--head", f"--port={port}", f"--num-cpus={workers}",
