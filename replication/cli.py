@@ -27,6 +27,7 @@ import signal
 import subprocess
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import hydra
 from omegaconf import DictConfig
@@ -42,6 +43,10 @@ from replication.runner.lifeline import (
     watch_parent_from_environment,
 )
 from replication.runner.preflight import check_yaml, preflight
+
+if TYPE_CHECKING:  # imported where they are used: the numerical stack loads after the checks that need none
+    from replication.run import Run
+    from replication.runner.store import Store
 
 HYDRA_FLAGS = ("--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc")
 MULTIRUN_FLAGS = ("--multirun", "-m")
@@ -138,16 +143,22 @@ def check_request(argv: list[str]) -> None:
         preflight(cfg, written[name])
 
 
-def interrupted(store=None, runs=None) -> None:
-    """The one line of a Ctrl-C or SIGTERM, and exit status 128 + the signal (130, 143) as shells expect."""
+def interrupted(held: "list[tuple[Store, list[Run]]] | None" = None) -> None:
+    """The one line of a Ctrl-C or SIGTERM, and exit status 128 + the signal (130, 143) as shells expect: how
+    many of the request's runs (each with the store that holds it, in ``held``) are stored, whenever they were."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while we count must not print a traceback
     stop_children()
-    if store is None or runs is None:
+    if held is None:
         print("interrupted: rerun the same command to resume", file=sys.stderr)
     else:
-        stored = sum(store.path(run).exists() for run in runs)
-        print(f"interrupted: {stored} runs stored, rerun the same command to resume", file=sys.stderr)
+        print(f"interrupted: {stored(held)} runs stored, rerun the same command to resume", file=sys.stderr)
     raise SystemExit(interrupt_status())
+
+
+def stored(held: "list[tuple[Store, list[Run]]]") -> int:
+    """How many distinct runs of ``held`` (runs, each list with the store that is to hold it) are stored: a run
+    two universes share, or an experiment's runs listed twice, counted once."""
+    return len({path for store, runs in held for run in runs if (path := store.path(run)).exists()})
 
 
 def draw_experiment(cfg: DictConfig, runs: list, held) -> None:
@@ -225,7 +236,7 @@ def run_experiment(cfg: DictConfig) -> None:
         fail(f"{cfg.experiment.name}: a run ran out of memory ({error}): ask for fewer particles or fewer workers "
              "(n_jobs)")
     except KeyboardInterrupt:
-        interrupted(store, runs)
+        interrupted([(store, runs)])
 
 
 def plan(cfg: DictConfig, runs: list, held, n_jobs: int) -> None:
@@ -266,7 +277,6 @@ def run_multiverse(cfg: DictConfig) -> None:
     distinct = sum(len(multiverse.runs_of(experiment)) for experiment in multiverse.experiments)
     print(f"{name}: {len(multiverse.universes)} universes of {len(multiverse.choices)} choices, "
           f"{distinct} distinct runs")
-    store, runs = None, None
     recorded, layers = universes_beneath(cfg, multiverse)
     if note := missing(cfg):
         print(note, file=sys.stderr)
@@ -290,8 +300,8 @@ def run_multiverse(cfg: DictConfig) -> None:
                 continue
             for experiment in multiverse.experiments:
                 held = layers[universe.name, experiment]
-                store, runs = held.store, held.computed(multiverse.runs[universe.name, experiment])
-                done = execute(runs, store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
+                runs = held.computed(multiverse.runs[universe.name, experiment])
+                done = execute(runs, held.store, n_jobs=n_jobs, backend=backend, progress=cfg.progress, address=address)
                 print(f"{where}: {experiment}: {done} runs computed, {len(runs) - done} already stored"
                       + (f", {len(held.recorded)} read from the record" if held.recorded else ""), flush=True)
         if cfg.draw:
@@ -307,8 +317,9 @@ def run_multiverse(cfg: DictConfig) -> None:
             print(f"{name}: report in {written}; index in {index}")
     except (BackendError, DiskFull) as error:  # the store's (StoreFull) or the reports'
         fail(str(error))
-    except KeyboardInterrupt:
-        interrupted(store, runs)
+    except KeyboardInterrupt:  # a universe's runs may be another's: each counted once
+        interrupted([(held.store, held.computed(multiverse.runs[universe, experiment]))
+                     for (universe, experiment), held in layers.items()])
 
 
 def multiverse_forecast(cfg: DictConfig, multiverse, recorded: dict, n_jobs: int, layers: dict | None = None) -> str:

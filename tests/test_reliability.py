@@ -467,3 +467,21 @@ def test_a_run_computes_on_one_opencv_thread_and_gives_what_a_pool_of_them_gives
         outputs[arm] = done.stdout.strip().splitlines()[-1].split(" ", 1)
     assert outputs["pool"][0] == "2" and outputs["perform"][0] == "1"
     assert outputs["pool"][1] == outputs["perform"][1]
+
+
+def test_an_interrupted_multiverse_counts_every_stored_run_of_the_request_once(make_cfg, tmp_path):
+    """The interrupted line of a multiverse stopped in a later universe counts the runs its earlier universes
+    stored too (it counted only the step it was in: "0 runs stored" after a whole universe), each run once
+    where universes share it, across the experiments' stores."""
+    from replication.cli import stored
+
+    runs = {name: expand(make_cfg(name, *TINY)) for name in ("hspf_ungm", "ungm_horizon")}
+    stores = {name: Store(tmp_path, name) for name in runs}
+    for name, count in {"hspf_ungm": 3, "ungm_horizon": 2}.items():
+        for run in runs[name][:count]:
+            stores[name].path(run).parent.mkdir(parents=True, exist_ok=True)
+            stores[name].path(run).write_text("{}")
+    held = [(stores["hspf_ungm"], runs["hspf_ungm"]), (stores["ungm_horizon"], runs["ungm_horizon"]),
+            (stores["hspf_ungm"], runs["hspf_ungm"][1:4])]  # a later universe sharing two stored runs
+    assert stored(held) == 5
+    assert stored(held[2:]) == 2
