@@ -447,6 +447,9 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
     multiverse = load(cfg)
     execute(multiverse.runs_of("hspf_ungm"), Store(tmp_path / "store", "hspf_ungm"), n_jobs=2, progress=False)
     entry = write([cfg], tmp_path / "store", tmp_path / "record").experiments["hspf_test_readings"]
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):  # and one with the experiment too
+        experiment = compose("config", overrides=["experiment=hspf_ungm", "scale=paper", f"store={tmp_path}/store"])
+    write([experiment, cfg], tmp_path / "store", tmp_path / "both")
     assert entry.runs == sum(len(runs) for runs in multiverse.runs.values())  # a shared run in each universe
     assert sorted(entry.files) == ["hspf_test_readings/universes/default.parquet",
                                    "hspf_test_readings/universes/hms=larger.parquet"]
@@ -489,6 +492,23 @@ def test_a_multiverse_is_recorded_universe_by_universe_and_judged_from_the_recor
         "stored": len(larger_runs) - 1, "read from the record": 0, "to compute": 1}
     cfg.record = str(tmp_path / "record")
     assert multiverse_forecast(cfg, multiverse, recorded_universes(cfg, multiverse), 2).endswith(": 0 runs to compute")
+    # grown by a repetition, with nothing stored, from a record that holds the experiment too (as the project's
+    # does: the default universe is its runs): each universe's recorded runs are read from the record, the
+    # larger memory's HSPF runs from its universe's file (no experiment's files have them), and only the new
+    # repetition's runs that no file holds are computed
+    from replication.record.layer import universes_beneath
+
+    cfg.experiment.multiverse.runs.paper, cfg.store, cfg.record = 6, str(tmp_path / "empty"), str(tmp_path / "both")
+    grown = load(cfg)
+    left = universes_left(cfg, grown, *universes_beneath(cfg, grown))
+    assert list(universes_beneath(cfg, grown)[0]) == ["default"]  # read whole: the experiment's own runs
+    assert {where: len(runs) for where, runs in left.items()} == {
+        "stored": 0, "read from the record": len(grown.runs[larger.name, "hspf_ungm"]) - 1, "to compute": 1}
+    assert [(run.method, run.repetition) for run in left["to compute"].values()] == [("HSPF", 5)]
+    # and once computed, the grown multiverse is recorded from the record's rows and that one stored run
+    execute(list(left["to compute"].values()), Store(tmp_path / "empty", "hspf_ungm"), n_jobs=1, progress=False)
+    grown_entry = write([cfg], tmp_path / "empty", tmp_path / "both").experiments["hspf_test_readings"]
+    assert grown_entry.runs == entry.runs + 3  # a repetition more of the larger memory's 3 methods
 
 
 def test_every_curved_figure_kind_has_its_curve_table_and_no_other_kind_does():

@@ -80,23 +80,53 @@ def reads_record(cfg: DictConfig) -> bool:
     return bool(cfg.get("skip_recorded")) and cfg.scale == SCALE
 
 
-def beneath(cfg: DictConfig, runs: list[Run], store: Store) -> Layered:
+def beneath(cfg: DictConfig, runs: list[Run], store: Store, universe: tuple[str, str] | None = None) -> Layered:
     """``store`` with the record ``cfg.record`` beneath it for ``runs`` (of one experiment): the store alone
     below the paper scale, with ``skip_recorded=false``, where there is no record, where the record's files of
     the experiment are damaged (said once, on stderr), or where it holds none of the runs as this code
-    computes them."""
+    computes them.  For the runs of ``universe`` (a multiverse's name and one of its universes') the record's
+    file of that universe is read too, for the runs the experiment's own files lack: a universe the record
+    holds in part (its multiverse grown by a repetition or a swept value) computes only what it lacks."""
     if not runs or not reads_record(cfg):
         return Layered(store)
     root, name = resolve(cfg.record), runs[0].experiment
-    entry = checked(root, name)
-    if entry is None:
+    source = runs_source(root, name, universe)
+    if source is None:
         return Layered(store)
+    held = {run.run_id for run, row in source.found(runs) if row["run_key"] == run.key}
+    recorded = frozenset(run.run_id for run in runs if run.run_id in held
+                         and not (store.path(run).exists() or store.failure_path(run).exists()))
+    entry, record = checked(root, name), Record(root)  # the experiment's curve tables: of exactly its runs
+    whole = entry is not None and len(runs) == entry.runs and record.holds(runs)
+    return Layered(store, source, recorded, record.curves(name) if recorded and whole else None)
+
+
+def runs_source(root: Path, name: str, universe: tuple[str, str] | None = None) -> Record | None:
+    """Where the record at ``root`` holds runs of experiment ``name``: its files, and beside them, for a run of
+    ``universe`` (a multiverse's name and one of its universes'), that universe's file (:class:`Beside`),
+    each only where its files have the SHA-256 the manifest gives them (:func:`checked`); None where neither."""
     record = Record(root)
-    held = [run for run, row in record.found(runs) if row["run_key"] == run.key]
-    recorded = frozenset(run.run_id for run in held
-                         if not (store.path(run).exists() or store.failure_path(run).exists()))
-    whole = len(held) == len(runs) == entry.runs  # the record's curve tables are of exactly these runs
-    return Layered(store, record, recorded, record.curves(name) if recorded and whole else None)
+    sources = [record] if checked(root, name) is not None else []
+    if universe and checked(root, universe[0]) is not None:
+        sources.append(record.universe(*universe))
+    return (sources[0] if len(sources) == 1 else Beside(root, tuple(sources))) if sources else None
+
+
+class Beside(Record):
+    """Records read one beside the other (an experiment's own files, then one universe's): a run's row is the
+    first that has the run's key, or else the first there is (a stale one: :meth:`Record.stale`)."""
+
+    def __init__(self, root: Path, sources: tuple[Record, ...]):
+        super().__init__(root)
+        self.sources = sources
+
+    def found(self, runs: list[Run]) -> list[tuple[Run, dict]]:
+        pairs = []
+        for run in runs:
+            rows = [row for source in self.sources for _, row in source.found([run])]
+            if rows:
+                pairs.append((run, next((row for row in rows if row["run_key"] == run.key), rows[0])))
+        return pairs
 
 
 def checked(root: Path, name: str) -> Entry | None:
@@ -155,10 +185,11 @@ def recorded_universes(cfg: DictConfig, multiverse) -> dict[str, Record]:
 
 def universes_beneath(cfg: DictConfig, multiverse) -> tuple[dict[str, Record], dict[tuple[str, str], Layered]]:
     """What a multiverse's runs are read from: the universes the record holds whole (:func:`recorded_universes`),
-    and for each other universe and experiment, the store with the record beneath it (:func:`beneath`)."""
+    and for each other universe and experiment, the store with the record beneath it, the experiment's files
+    and the universe's (:func:`beneath`)."""
     recorded = recorded_universes(cfg, multiverse)
     return recorded, {(universe.name, name): beneath(cfg, multiverse.runs[universe.name, name],
-                                                     Store(resolve(cfg.store), name))
+                                                     Store(resolve(cfg.store), name), (multiverse.name, universe.name))
                       for universe in multiverse.universes if universe.name not in recorded
                       for name in multiverse.experiments}
 

@@ -26,10 +26,10 @@ from omegaconf import DictConfig
 from replication.errors import ConfigError
 from replication.evidence.figures import figure_specs
 from replication.evidence.tables import TABLE_KINDS, table_specs
-from replication.record.layer import SCALE, checked
+from replication.record.layer import SCALE, runs_source
 from replication.record.manifest import Entry, Manifest
 from replication.record.runs import (
-    CURVES_DIR, RUNS_FILE, UNIVERSE, Record, read_rows, row, runs_table, universe_path, write_table,
+    CURVES_DIR, RUNS_FILE, UNIVERSE, read_rows, row, runs_table, universe_path, write_table,
 )
 from replication.run import Run
 from replication.runner.config import expand, experiment_at_scale
@@ -67,12 +67,13 @@ def stored_rows(runs: list[Run], store: Store, series: tuple[str, ...],
     return rows, missing, from_record
 
 
-def recorded_rows(record: Path, runs: list[Run]) -> dict[str, dict]:
+def recorded_rows(record: Path, runs: list[Run], universe: tuple[str, str] | None = None) -> dict[str, dict]:
     """Run id -> the row of each of ``runs`` the record at ``record`` holds as this code computes it (its
-    recorded key the run's), where the record's files of their experiment are sound (:func:`.layer.checked`)."""
-    if not runs or checked(record, runs[0].experiment) is None:
-        return {}
-    return {run.run_id: found for run, found in Record(record).found(runs) if found["run_key"] == run.key}
+    recorded key the run's), where the record's files of their experiment, or of their ``universe``, are sound
+    (:func:`.layer.runs_source`)."""
+    source = runs_source(record, runs[0].experiment, universe) if runs else None
+    return {} if source is None else {run.run_id: found for run, found in source.found(runs)
+                                      if found["run_key"] == run.key}
 
 
 def write_experiment(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
@@ -110,7 +111,8 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
         for name in multiverse.experiments:
             series = kept_series(multiverse.experiment_configs[universe.name, name])
             runs = multiverse.runs[universe.name, name]
-            found, absent, _ = stored_rows(runs, Store(store_root, name), series, recorded_rows(record, runs))
+            found, absent, _ = stored_rows(runs, Store(store_root, name), series,
+                                           recorded_rows(record, runs, (multiverse.name, universe.name)))
             rows, missing = rows + [{**picks, **r} for r in found], missing + absent
         if missing:
             kept_as = "kept as recorded" if path.exists() else "not recorded"
