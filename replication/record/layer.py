@@ -97,8 +97,8 @@ def beneath(cfg: DictConfig, runs: list[Run], store: Store, universe: tuple[str,
     recorded = frozenset(run.run_id for run in runs if run.run_id in held
                          and not (store.path(run).exists() or store.failure_path(run).exists()))
     entry, record = checked(root, name), Record(root)  # the experiment's curve tables: of exactly its runs
-    whole = entry is not None and len(runs) == entry.runs and record.holds(runs)
-    return Layered(store, source, recorded, record.curves(name) if recorded and whole else None)
+    whole = bool(recorded) and entry is not None and len(runs) == entry.runs and record.holds(runs)
+    return Layered(store, source, recorded, record.curves(name) if whole else None)
 
 
 def runs_source(root: Path, name: str, universe: tuple[str, str] | None = None) -> Record | None:
