@@ -102,6 +102,11 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
     too long for one sitting is recorded universe by universe; the others are left as they are (a file
     written before stays), with one line each.  Its manifest entry: every universe file there is."""
     multiverse = load(_at_paper_scale(cfg))
+    # the record's rows of every universe are read before any of its files is written: a file rewritten no longer
+    # has the SHA-256 the manifest gives it until the manifest is, and the record of a damaged multiverse is not read
+    recorded = {(universe.name, name): recorded_rows(record, multiverse.runs[universe.name, name],
+                                                     (multiverse.name, universe.name))
+                for universe in multiverse.universes for name in multiverse.experiments}
     kept = set()
     for universe in multiverse.universes:
         path = universe_path(record, multiverse.name, universe.name)
@@ -110,9 +115,8 @@ def write_multiverse(cfg: DictConfig, store_root: Path, record: Path) -> Entry:
         rows, missing = [], 0
         for name in multiverse.experiments:
             series = kept_series(multiverse.experiment_configs[universe.name, name])
-            runs = multiverse.runs[universe.name, name]
-            found, absent, _ = stored_rows(runs, Store(store_root, name), series,
-                                           recorded_rows(record, runs, (multiverse.name, universe.name)))
+            found, absent, _ = stored_rows(multiverse.runs[universe.name, name], Store(store_root, name), series,
+                                           recorded[universe.name, name])
             rows, missing = rows + [{**picks, **r} for r in found], missing + absent
         if missing:
             kept_as = "kept as recorded" if path.exists() else "not recorded"
