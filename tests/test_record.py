@@ -319,16 +319,10 @@ def test_the_shipped_record_is_whole_and_its_quickest_runs_recompute_identically
         verdicts(folder, folder, [], 2)
 
 
-# parts of the record recorded by older run code while they are rebuilt (none now: issue 59's rebuild is whole);
-# each name leaves when it is
-REBUILDING: set[str] = set()
-
-
 def test_every_recorded_run_is_the_one_this_code_would_make():
     """A change to any file a run executes (its task, filter, or a module they import, such as ``paths.py``)
     gives its runs new keys, and the record's runs of the old keys are stale: shown, never read as this code's.
-    Such a change must come with the record rebuilt, so none of the record's parts holds a stale run (but
-    the parts being rebuilt)."""
+    Such a change must come with the record rebuilt, so none of the record's parts holds a stale run."""
     from hydra import compose, initialize_config_dir
 
     from replication.paths import CONF_DIR
@@ -344,9 +338,7 @@ def test_every_recorded_run_is_the_one_this_code_would_make():
             cfg = compose("config", overrides=[f"experiment={name}", "scale=paper"])
             multiverse = "multiverse" in cfg.experiment
             stale[name] = record.stale_universes(load(cfg)) if multiverse else len(record.stale(expand(cfg)))
-    assert {name: n for name, n in stale.items() if n and name not in REBUILDING} == {}, \
-        "run code changed: rebuild these parts of the record"
-    assert all(stale.get(name) for name in REBUILDING), "rebuilt (or dropped): take it out of REBUILDING"
+    assert {name: n for name, n in stale.items() if n} == {}, "run code changed: rebuild these parts of the record"
 
 
 def test_diff_lists_each_changed_claim_and_cell_before_and_after(tmp_path, capsys):
